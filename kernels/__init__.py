@@ -1,0 +1,10 @@
+"""OpenCL C sources of pyoa, shipped inside the package as ``pyoa.kernels``.
+
+``setup.cfg`` maps this folder into the package (``package_dir``), so the
+``.cl`` files are installed with a plain ``pip install .``. They are read with
+:mod:`importlib.resources` and concatenated in :data:`SOURCES` order by
+:mod:`pyoa._opencl.program`: each file relies only on those before it.
+"""
+
+#: The kernel sources in dependency order.
+SOURCES = ("hashes.cl", "floats.cl", "oa.cl", "generate.cl")

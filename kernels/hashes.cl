@@ -1,0 +1,64 @@
+/* Integer hashes of SPEC sections 2 and 3 (mirrors pyoa/reference/hashes.py).
+ * All arithmetic is uint with wrap-around. */
+
+#define STRATUM_KEY    0x51633e2du
+#define SUBSTRATUM_KEY 0x68bc21ebu
+#define JITTER_KEY     0x02e5be93u
+#define PIXEL_KEY      0x5bd1e995u
+#define BLOCK_KEY      0x1b873593u
+
+/* Kensler's permute with the wrap-safe final shift; 1 <= l <= 2^31. */
+uint permute(uint i, uint l, uint p)
+{
+    if (p == 0u) return i;
+    uint w = l - 1u;
+    w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
+    do {
+        i ^= p;             i *= 0xe170893du;
+        i ^= p >> 16;
+        i ^= (i & w) >> 4;
+        i ^= p >> 8;        i *= 0x0929eb3fu;
+        i ^= p >> 23;
+        i ^= (i & w) >> 1;  i *= 1u | (p >> 27);
+        i *= 0x6935fa69u;
+        i ^= (i & w) >> 11; i *= 0x74dcb303u;
+        i ^= (i & w) >> 2;  i *= 0x9e501cc3u;
+        i ^= (i & w) >> 2;  i *= 0xc860a3dfu;
+        i &= w;
+        i ^= i >> 5;
+    } while (i >= l);
+    return (i + p % l) % l;
+}
+
+/* Kensler's randfloat: float in [0, 1); 0.5 for p == 0. */
+float randfloat(uint i, uint p)
+{
+    if (p == 0u) return 0.5f;
+    i ^= p;
+    i ^= i >> 17;
+    i ^= i >> 10;  i *= 0xb36534e5u;
+    i ^= i >> 12;
+    i ^= i >> 21;  i *= 0x93fc4795u;
+    i ^= 0xdf6e307fu;
+    i ^= i >> 17;  i *= 1u | (p >> 18);
+    return convert_float_rte(i) * as_float(0x2f7ffffeu);
+}
+
+/* Wellons' lowbias32. */
+uint mix32(uint x)
+{
+    x ^= x >> 16; x *= 0x7feb352du;
+    x ^= x >> 15; x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+uint hash_pair(uint a, uint b, uint key)
+{
+    uint h = mix32(b ^ mix32(a ^ key));
+    return h ? h : key;
+}
+
+uint pixel_seed(uint seed, uint pixel) { return hash_pair(seed, pixel, PIXEL_KEY); }
+
+uint block_seed(uint p, uint block) { return block ? hash_pair(p, block, BLOCK_KEY) : p; }

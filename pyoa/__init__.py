@@ -1,0 +1,23 @@
+"""pyoa: orthogonal-array sampling for Monte Carlo rendering.
+
+Stateless, hash-based orthogonal-array samplers after Jarosz et al.,
+"Orthogonal Array Sampling for Monte Carlo Rendering" (EGSR 2019), computed
+in bulk by OpenCL kernels (PoCL by default), a NumPy fallback, or one value
+at a time by the pure-Python reference, all with the same float32 bits.
+
+>>> import pyoa
+>>> smp = pyoa.sampler("bose", spp=121, dims=8, seed=7)
+>>> x = smp.generate(pixels=range(16))        # float32, shape (16, 121, 8)
+"""
+
+from . import reference
+from .backends import PyoaFallbackWarning, backends
+from .constructions import OFFSETS, SppChoice, valid_spp
+from .samplers import Sampler, sampler, samplers
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "sampler", "samplers", "Sampler", "valid_spp", "SppChoice", "backends", "reference",
+    "OFFSETS", "PyoaFallbackWarning", "__version__",
+]

@@ -1,0 +1,119 @@
+"""Integer hashes of SPEC sections 2 and 3 over NumPy uint32 arrays.
+
+Mirrors :mod:`pyoa.reference.hashes` operation for operation; NumPy's uint32
+arithmetic wraps modulo ``2**32`` as the spec requires. Arguments broadcast.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..reference.floats import UNIT_SCALE
+from ..reference.hashes import BLOCK_KEY, JITTER_KEY, PIXEL_KEY, STRATUM_KEY, SUBSTRATUM_KEY
+
+U32 = np.uint32
+_UNIT_SCALE = np.float32(UNIT_SCALE)
+
+
+def _u32(x) -> np.ndarray:
+    return np.asarray(x, dtype=U32)
+
+
+def _permute_round(i: np.ndarray, p: np.ndarray, w: np.uint32) -> np.ndarray:
+    """One pass of Kensler's bijection on ``[0, w]`` (the body of the cycle walk)."""
+    i = i ^ p
+    i *= U32(0xE170893D)
+    i ^= p >> U32(16)
+    i ^= (i & w) >> U32(4)
+    i ^= p >> U32(8)
+    i *= U32(0x0929EB3F)
+    i ^= p >> U32(23)
+    i ^= (i & w) >> U32(1)
+    i *= U32(1) | (p >> U32(27))
+    i *= U32(0x6935FA69)
+    i ^= (i & w) >> U32(11)
+    i *= U32(0x74DCB303)
+    i ^= (i & w) >> U32(2)
+    i *= U32(0x9E501CC3)
+    i ^= (i & w) >> U32(2)
+    i *= U32(0xC860A3DF)
+    i &= w
+    i ^= i >> U32(5)
+    return i
+
+
+def permute(i, l: int, p) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.permute` (``l`` a scalar, ``1 <= l <= 2**31``)."""
+    i, p = np.broadcast_arrays(_u32(i), _u32(p))
+    shape = i.shape
+    i, p = i.ravel(), p.ravel()
+    w = l - 1
+    for k in (1, 2, 4, 8, 16):
+        w |= w >> k
+    w = U32(w)
+    out = i.copy()
+    todo = np.flatnonzero(p != 0)  # p == 0 is the identity
+    if todo.size:
+        pt = p[todo]
+        cur = i[todo]
+        res = np.empty_like(cur)
+        pending = np.arange(todo.size)
+        while pending.size:  # cycle walking until every lane is below l
+            cur = _permute_round(cur, pt[pending], w)
+            ok = cur < l
+            res[pending[ok]] = cur[ok]
+            pending, cur = pending[~ok], cur[~ok]
+        out[todo] = (res + pt % U32(l)) % U32(l)
+    return out.reshape(shape)
+
+
+def randfloat(i, p) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.randfloat`: float32 in ``[0, 1)``."""
+    i, p = np.broadcast_arrays(_u32(i), _u32(p))
+    i = i ^ p
+    i ^= i >> U32(17)
+    i ^= i >> U32(10)
+    i *= U32(0xB36534E5)
+    i ^= i >> U32(12)
+    i ^= i >> U32(21)
+    i *= U32(0x93FC4795)
+    i ^= U32(0xDF6E307F)
+    i ^= i >> U32(17)
+    i *= U32(1) | (p >> U32(18))
+    # uint32 -> float32 rounds to nearest even, then one float32 multiply.
+    r = i.astype(np.float32) * _UNIT_SCALE
+    return np.where(p == 0, np.float32(0.5), r)
+
+
+def mix32(x) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.mix32` (Wellons' lowbias32)."""
+    x = _u32(x).copy()
+    x ^= x >> U32(16)
+    x *= U32(0x7FEB352D)
+    x ^= x >> U32(15)
+    x *= U32(0x846CA68B)
+    x ^= x >> U32(16)
+    return x
+
+
+def hash_pair(a, b, key: int) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.hashes.hash_pair` (never 0)."""
+    h = mix32(_u32(b) ^ mix32(_u32(a) ^ U32(key)))
+    return np.where(h == 0, U32(key), h)
+
+
+def pixel_seed(seed, pixel) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.pixel_seed`."""
+    return hash_pair(seed, pixel, PIXEL_KEY)
+
+
+def block_seed(p, block) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.block_seed` (block 0 keeps ``p``)."""
+    p, block = np.broadcast_arrays(_u32(p), _u32(block))
+    return np.where(block == 0, p, hash_pair(p, block, BLOCK_KEY))
+
+
+def dimension_seeds(p, j):
+    """Vectorized :func:`pyoa.reference.dimension_seeds`: (P1, P2, P3)."""
+    q = _u32(p) * (_u32(j) + U32(1))
+    return q * U32(STRATUM_KEY), q * U32(SUBSTRATUM_KEY), q * U32(JITTER_KEY)

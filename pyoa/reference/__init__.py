@@ -1,0 +1,13 @@
+"""The pure-Python reference of pyoa: the oracle every backend is tested against.
+
+Scalar, one value at a time, written to be read next to ``SPEC.md``. It is
+slow by design; use :func:`pyoa.sampler` for bulk generation.
+
+Public functions: :func:`permute`, :func:`randfloat`, :func:`pixel_seed`,
+:func:`block_seed`, :func:`bose`, :func:`cmjnd`.
+"""
+
+from .hashes import block_seed, dimension_seeds, mix32, permute, pixel_seed, randfloat
+from .oa import bose, cmjnd
+
+__all__ = ["permute", "randfloat", "pixel_seed", "block_seed", "dimension_seeds", "mix32", "bose", "cmjnd"]

@@ -1,0 +1,149 @@
+"""Orthogonal-array samplers of SPEC section 5, one value at a time.
+
+Each function returns ``x(i, j)``: dimension ``j`` of sample ``i`` of the
+array with seed ``p``, as a Python float holding a float32 value in
+``[0, 1)``. A value is built from one OA entry (SPEC section 1)::
+
+    x = (stratum + (sub + jitter) / M) / s
+
+with ``stratum = permute(A_ij, s, P1_j)``, ``sub`` chosen by the offset style
+(SPEC section 4) and ``jitter = 0.5 + J * (randfloat(i, P3_j) - 0.5)``.
+Dimensions past a block of ``block_dims`` columns come from independently
+randomized copies of the array (SPEC section 6, :func:`~.hashes.block_seed`).
+
+References
+----------
+.. [1] W. Jarosz, A. Enayet, A. Kensler, C. Kilpatrick, P. Christensen,
+   "Orthogonal Array Sampling for Monte Carlo Rendering", Computer Graphics
+   Forum (EGSR) 38(4), 2019.
+.. [2] R. C. Bose, "On the application of the properties of Galois fields to
+   the problem of construction of hyper-Graeco-Latin squares", Sankhya 3, 1938.
+"""
+
+from __future__ import annotations
+
+from ..constructions import OFFSETS, is_prime
+from .floats import f32, jitter_value, sample_value
+from .hashes import MASK, block_seed, dimension_seeds, permute, randfloat
+
+
+def _check_common(i: int, N: int, j: int, p: int, offset: str, jitter: float) -> float:
+    if not 0 <= i < N:
+        raise ValueError(f"sample index i must be in [0, {N}), got {i}")
+    if j < 0:
+        raise ValueError(f"dimension j must be >= 0, got {j}")
+    if not 0 <= p <= MASK:
+        raise ValueError(f"seed p must be a uint32 in [0, 2**32), got {p}")
+    if offset not in OFFSETS:
+        raise ValueError(f"unknown offset {offset!r}; valid: {', '.join(OFFSETS)}")
+    if not 0.0 <= jitter <= 1.0:  # also rejects NaN
+        raise ValueError(f"jitter must be in [0, 1], got {jitter}")
+    return f32(jitter)
+
+
+def _centered(M: int) -> float:
+    # (M-1)/2 is an integer or a half-integer below 2**23: exact in float32.
+    return (M - 1) / 2
+
+
+def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
+    """Bose OA sample, strength 2: ``s`` prime, ``N = s**2``, ``s + 1`` columns per block.
+
+    The integer array is ``A_i0 = i // s``, ``A_i1 = i % s`` and
+    ``A_ij = (A_i0 + (j-1) A_i1) mod s`` for ``2 <= j <= s``. Column ``j`` is
+    paired with column ``k`` (1 for 0, 0 for 1, ``j-1`` for odd ``j``, ``j+1``
+    for even ``j``, with ``k-1`` taken mod s), whose entry places the point
+    inside its coarse stratum: ``M = s`` sub-strata.
+
+    Parameters
+    ----------
+    i : int
+        Sample index in ``[0, s**2)``.
+    j : int
+        Dimension, any ``j >= 0`` (blocks of ``s + 1``).
+    s : int
+        Strata per axis, a prime.
+    p : int
+        Array seed (uint32); 0 is the canonical array.
+    offset : {"cmj", "mj", "j", "centered"}
+        Offset style (SPEC section 4).
+    jitter : float
+        Jitter amount J in [0, 1].
+    """
+    if not is_prime(s):
+        raise ValueError(f"bose needs s prime, got s={s}")
+    J = _check_common(i, s * s, j, p, offset, jitter)
+    block, j = divmod(j, s + 1)
+    p = block_seed(p, block)
+    P1, P2, P3 = dimension_seeds(p, j)
+
+    a0, a1 = i // s, i % s
+    if j == 0:
+        aij, aik = a0, a1
+    elif j == 1:
+        aij, aik = a1, a0
+    else:
+        k = j - 1 if j % 2 else j + 1
+        aij = (a0 + (j - 1) * a1) % s
+        aik = (a0 + ((k - 1) % s) * a1) % s
+
+    stratum = permute(aij, s, P1)
+    if offset == "centered":
+        sub = _centered(s)
+    elif offset == "j":
+        sub = permute(aik, s, ((aik * s + aij + 1) * P2) & MASK)
+    elif offset == "mj":
+        sub = permute(aik, s, ((aij + 1) * P2) & MASK)
+    else:  # cmj
+        sub = permute(aik, s, P2)
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), s, s)
+
+
+def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
+    """High-dimensional correlated multi-jittered sample [1]_: any ``s >= 2``, ``N = s**t``.
+
+    ``A_ij`` is the ``j``-th base-``s`` digit of ``i`` (least significant
+    first), so the ``t`` columns form a full ``t``-dimensional grid of
+    ``s**t`` coarse cells (strength ``t``). The other ``t - 1`` digits, read
+    as a base-``s`` number ``v = i mod s**j + (i // s**(j+1)) s**j``, pick one
+    of ``M = s**(t-1)`` sub-strata, which makes every dimension a 1D Latin
+    hypercube for ``mj`` and ``cmj``.
+
+    Parameters
+    ----------
+    i : int
+        Sample index in ``[0, s**t)``.
+    j : int
+        Dimension, any ``j >= 0`` (blocks of ``t``).
+    s : int
+        Strata per axis, ``s >= 2``.
+    t : int
+        Strength: dimensions per block, ``t >= 1``.
+    p, offset, jitter
+        As for :func:`bose`.
+    """
+    if s < 2 or t < 1:
+        raise ValueError(f"cmjnd needs s >= 2 and t >= 1, got s={s}, t={t}")
+    N = s**t
+    J = _check_common(i, N, j, p, offset, jitter)
+    block, j = divmod(j, t)
+    p = block_seed(p, block)
+    P1, P2, P3 = dimension_seeds(p, j)
+
+    M = N // s
+    sj = s**j
+    aij = (i // sj) % s
+    v = i % sj + (i // (sj * s)) * sj
+
+    stratum = permute(aij, s, P1)
+    if offset == "centered":
+        sub = _centered(M)
+    elif offset == "j":
+        sub = permute(v, M, ((i + 1) * P2) & MASK)
+    elif offset == "mj":
+        sub = permute(v, M, ((aij + 1) * P2) & MASK)
+    else:  # cmj
+        sub = permute(v, M, P2)
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
+
+
