@@ -1,0 +1,132 @@
+"""The ``pyoa`` command line.
+
+``pyoa points``   generate a point set and save it (.npy or .csv)
+``pyoa samplers`` list the samplers, ``pyoa spp NAME`` their valid sample counts
+``pyoa backends`` report the usable backends and OpenCL devices
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import numpy as np
+
+from . import OFFSETS, backends, sampler, samplers, valid_spp
+from .atomic import atomic_path
+
+FORMATS = (".npy", ".csv")
+
+
+def save_points(x: np.ndarray, path: str, pixels: range) -> None:
+    """Save a ``(pixels, samples, dims)`` array atomically as .npy or .csv.
+
+    The CSV has one row per (pixel, sample): ``pixel,sample,x0,...`` with
+    values printed with 9 significant digits, enough to round-trip float32.
+    """
+    suffix = path[path.rfind("."):].lower() if "." in path else ""
+    if suffix not in FORMATS:
+        raise ValueError(f"--out must end in {' or '.join(FORMATS)}, got {path!r}")
+    with atomic_path(path) as tmp:
+        if suffix == ".npy":
+            np.save(tmp, x)
+        else:
+            n_p, n_s, n_d = x.shape
+            pix = np.repeat(np.asarray(pixels, dtype=np.int64), n_s)
+            smp = np.tile(np.arange(n_s), n_p)
+            with open(tmp, "w") as fh:
+                fh.write(",".join(["pixel", "sample"] + [f"x{d}" for d in range(n_d)]) + "\n")
+                fmt = "%d,%d" + ",%.9g" * n_d
+                np.savetxt(fh, np.column_stack([pix, smp, x.reshape(n_p * n_s, n_d).astype(np.float64)]), fmt=fmt)
+
+
+def cmd_points(args) -> int:
+    smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, offset=args.offset,
+                  jitter=args.jitter, strength=args.strength, backend=args.backend, device=args.device)
+    pixels = range(args.pixel0, args.pixel0 + args.pixels)
+    t0 = time.perf_counter()
+    x = smp.generate(pixels=pixels, progress=not args.quiet)
+    dt = time.perf_counter() - t0
+    save_points(x, args.out, pixels)
+    if not args.quiet:
+        print(smp)
+        print(f"{x.size:,} values ({x.shape[0]} pixels x {x.shape[1]} samples x {x.shape[2]} dims) "
+              f"in {dt:.3f} s ({x.size / max(dt, 1e-9) / 1e6:.1f} M values/s) -> {args.out}")
+    return 0
+
+
+def cmd_samplers(args) -> int:
+    for name, desc in samplers().items():
+        print(f"{name:8s} {desc}")
+    return 0
+
+
+def cmd_spp(args) -> int:
+    choices = valid_spp(args.sampler, near=args.near, dims=args.dims, strength=args.strength)
+    print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
+    for c in choices[: args.limit]:
+        print(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}")
+    if len(choices) > args.limit:
+        print(f"... {len(choices) - args.limit} more (use --near N or --limit)")
+    return 0
+
+
+def cmd_backends(args) -> int:
+    for b in backends():
+        mark = "*" if b["default"] else " "
+        state = b["device"] if b["usable"] else f"not usable: {b['reason']}"
+        print(f"{mark} {b['name']:7s} {state}")
+        for d in b.get("devices", []):
+            print(f"      device {d}")
+    print("(* = what backend=None picks; choose with PYOA_BACKEND, PYOA_OPENCL_DEVICE)")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="pyoa", description="Orthogonal-array sampling for Monte Carlo rendering.")
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("points", help="generate a point set and save it (.npy or .csv)")
+    p.add_argument("--sampler", default="bose", help="sampler name (see `pyoa samplers`; default bose)")
+    p.add_argument("--spp", type=int, default=121, help="samples per pixel (default 121)")
+    p.add_argument("--dims", type=int, default=8, help="dimensions (default 8)")
+    p.add_argument("--pixels", type=int, default=1, help="number of pixels (default 1)")
+    p.add_argument("--pixel0", type=int, default=0, help="first pixel index (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="user seed in [0, 2^32) (default 0)")
+    p.add_argument("--offset", choices=OFFSETS, default="cmj", help="offset style (default cmj)")
+    p.add_argument("--jitter", type=float, default=1.0, help="jitter amount in [0, 1] (default 1)")
+    p.add_argument("--strength", type=int, default=None, help="strength t (cmjnd)")
+    p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="default: automatic")
+    p.add_argument("--device", default=None, help="OpenCL device selector (gpu, cpu, P:D, name)")
+    p.add_argument("--out", default="points.npy", help="output file, .npy or .csv (default points.npy)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    p.set_defaults(func=cmd_points)
+
+    p = sub.add_parser("samplers", help="list the samplers")
+    p.set_defaults(func=cmd_samplers)
+
+    p = sub.add_parser("spp", help="list a sampler's valid sample counts")
+    p.add_argument("sampler")
+    p.add_argument("--near", type=int, default=None, help="only the counts nearest this one")
+    p.add_argument("--dims", type=int, default=None)
+    p.add_argument("--strength", type=int, default=None)
+    p.add_argument("--limit", type=int, default=40, help="print at most this many (default 40)")
+    p.set_defaults(func=cmd_spp)
+
+    p = sub.add_parser("backends", help="report the usable backends and OpenCL devices")
+    p.set_defaults(func=cmd_backends)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    try:
+        return args.func(args)
+    except (ValueError, TypeError, FileNotFoundError) as exc:
+        ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -47,7 +47,7 @@ class DeviceInfo:
     def describe(self) -> str:
         return (
             f"{self.device.name.strip()} ({self.kind}) on "
-            f"{self.platform.name.strip()} [{self.platform.version.strip()}]"
+            f"{self.platform.name.strip()} [{' '.join(self.platform.version.split()[:4])}]"
         )
 
 
