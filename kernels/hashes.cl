@@ -1,5 +1,9 @@
 /* Integer hashes of SPEC sections 2 and 3 (mirrors pyoa/reference/hashes.py).
- * All arithmetic is uint with wrap-around. */
+ * All arithmetic is uint with wrap-around. randfloat's float multiply must not
+ * fuse with the subtraction in jitter_value once inlined (NVIDIA's compiler
+ * did exactly that when this pragma came only later, in floats.cl), so the
+ * pragma opens this file and program.source() puts it first in the program. */
+#pragma OPENCL FP_CONTRACT OFF
 
 #define STRATUM_KEY    0x51633e2du
 #define SUBSTRATUM_KEY 0x68bc21ebu

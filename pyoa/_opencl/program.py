@@ -34,7 +34,11 @@ def source() -> str:
     from .. import kernels
 
     root = resources.files(kernels)
-    return "\n".join(f"/* ---- {name} ---- */\n" + root.joinpath(name).read_text() for name in kernels.SOURCES)
+    # The pragma applies from where it appears to the end of the program:
+    # first, so no float operation of any file can be contracted into an FMA.
+    return "#pragma OPENCL FP_CONTRACT OFF\n" + "\n".join(
+        f"/* ---- {name} ---- */\n" + root.joinpath(name).read_text() for name in kernels.SOURCES
+    )
 
 
 def build(info: DeviceInfo):
