@@ -34,10 +34,10 @@ uint permute(uint i, uint l, uint p)
     return (i + p % l) % l;
 }
 
-/* Kensler's randfloat: float in [0, 1); 0.5 for p == 0. */
+/* Kensler's randfloat: float in [0, 1); 0.5 for p == 0. Written without an
+ * early return (a select at the end) so that PoCL can vectorize callers. */
 float randfloat(uint i, uint p)
 {
-    if (p == 0u) return 0.5f;
     i ^= p;
     i ^= i >> 17;
     i ^= i >> 10;  i *= 0xb36534e5u;
@@ -45,7 +45,8 @@ float randfloat(uint i, uint p)
     i ^= i >> 21;  i *= 0x93fc4795u;
     i ^= 0xdf6e307fu;
     i ^= i >> 17;  i *= 1u | (p >> 18);
-    return convert_float_rte(i) * as_float(0x2f7ffffeu);
+    float r = convert_float_rte(i) * as_float(0x2f7ffffeu);
+    return p ? r : 0.5f;
 }
 
 /* Wellons' lowbias32. */

@@ -32,8 +32,10 @@ class OpenCLBackend:
     def __init__(self, selector: str | None = None):
         self.info: DeviceInfo = select_device(selector)
         self.context, self.queue, self.program = build(self.info)
-        self._kernel = self.program.generate
         self._lock = threading.Lock()
+        # Kernel objects are fetched once (each retrieval builds a new one);
+        # their arguments are set under self._lock.
+        self._kernels = {k.function_name: k for k in self.program.all_kernels()}
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
 
@@ -42,6 +44,16 @@ class OpenCLBackend:
 
     def rows_per_chunk(self, n_dims: int) -> int:
         return max(1, self.max_chunk_values // max(1, n_dims))
+
+    def _uses_tables(self, req: Request) -> bool:
+        """The table path pays off when a table (E entries per pixel and
+        dimension) is no longer than the samples asked of that pixel."""
+        return req.offset in ("cmj", "centered") and self._table_entries(req) <= len(req.samples)
+
+    @staticmethod
+    def _table_entries(req: Request) -> int:
+        prm = req.params
+        return prm.s + (prm.M if req.offset == "cmj" else 0) + 1
 
     def fill(self, req: Request, row0: int, row1: int, out: np.ndarray) -> None:
         """Write rows ``[row0, row1)`` of ``req`` into ``out`` (C-contiguous float32)."""
@@ -52,19 +64,49 @@ class OpenCLBackend:
             return
         mf = cl.mem_flags
         ro = mf.READ_ONLY | mf.COPY_HOST_PTR
-        global_size = -(-n_values // GROUP_SIZE) * GROUP_SIZE
+        prm = req.params
+        n_s = len(req.samples)
         with self._lock:
-            pixels = cl.Buffer(self.context, ro, hostbuf=req.pixels if len(req.pixels) else np.zeros(1, np.uint32))
             samples = cl.Buffer(self.context, ro, hostbuf=req.samples)
             dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
             buf = cl.Buffer(self.context, mf.WRITE_ONLY, size=n_values * 4)
-            self._kernel(
-                self.queue, (global_size,), (GROUP_SIZE,),
-                buf, pixels, samples, dims,
-                np.uint32(len(req.samples)), np.uint32(req.n_dims), np.uint64(row0), np.uint32(n_values),
-                np.uint32(req.seed), np.uint32(req.construction.code),
-                np.uint32(req.params.s), np.uint32(req.params.strength),
-                np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
-            )
+            # Only the pixels of these rows travel to the device.
+            pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
+            pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
+            if self._uses_tables(req):
+                E = self._table_entries(req)
+                n_entries = (pix1 - pix0) * req.n_dims * E
+                tab = cl.Buffer(self.context, mf.READ_WRITE, size=n_entries * 4)
+                self._kernels["tables"](
+                    self.queue, (_padded(n_entries),), (GROUP_SIZE,),
+                    tab, pixels, dims, np.uint32(n_entries), np.uint32(req.n_dims), np.uint32(E),
+                    np.uint32(req.seed), np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M),
+                )
+                if req.construction.name == "bose":
+                    kernel, pw = self._kernels["generate_tabled_bose"], [1]
+                else:  # s^col of each CMJND column, all below 2**24
+                    kernel, pw = self._kernels["generate_tabled_cmjnd"], [prm.s**k for k in range(prm.block_dims)]
+                powers = cl.Buffer(self.context, ro, hostbuf=np.array(pw, dtype=np.uint32))
+                kernel(
+                    self.queue, (_padded(n_values),), (GROUP_SIZE,),
+                    buf, tab, samples, dims, powers, np.uint32(n_s), np.uint32(req.n_dims),
+                    np.uint32(row0 - pix0 * n_s), np.uint32(n_values), np.uint32(E),
+                    np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M),
+                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+                )
+            else:
+                self._kernels["generate"](
+                    self.queue, (_padded(n_values),), (GROUP_SIZE,),
+                    buf, pixels, samples, dims,
+                    np.uint32(n_s), np.uint32(req.n_dims), np.uint32(row0 - pix0 * n_s), np.uint32(n_values),
+                    np.uint32(req.seed), np.uint32(req.construction.code),
+                    np.uint32(prm.s), np.uint32(prm.strength),
+                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+                )
             cl.enqueue_copy(self.queue, out, buf)
             self.queue.finish()
+
+
+def _padded(n: int) -> int:
+    """``n`` rounded up to a multiple of :data:`GROUP_SIZE`."""
+    return -(-n // GROUP_SIZE) * GROUP_SIZE
