@@ -1,15 +1,34 @@
-"""The NumPy backend: the CPU fallback used when no OpenCL device is usable."""
+"""The NumPy backend: the CPU fallback used when no OpenCL device is usable.
+
+Like the OpenCL backend it has two paths with the same bits: every value
+from scratch (:func:`.oa.bose`, :func:`.oa.cmjnd`), or, for ``cmj`` and
+``centered``, the permutations that do not depend on the sample computed once
+per (pixel, dimension) as tables and gathered.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from ..request import Request
 from . import oa
-from .hashes import pixel_seed
+from .floats import F32
+from .hashes import U32, permute, pixel_seed
 
 #: Values per chunk: bounds the temporaries (about 20 arrays of this size).
 CHUNK_VALUES = 1 << 20
+
+
+def table_entries(req: Request) -> int:
+    """Permutation entries per (pixel, dimension) of the table path: s strata,
+    plus M sub-strata for ``cmj``."""
+    return req.params.s + (req.params.M if req.offset == "cmj" else 0)
+
+
+def uses_tables(req: Request) -> bool:
+    """Tables pay off when they are no longer than the samples asked per pixel."""
+    return req.offset in ("cmj", "centered") and table_entries(req) < len(req.samples)
 
 
 class NumpyBackend:
@@ -27,11 +46,36 @@ class NumpyBackend:
         """Write rows ``[row0, row1)`` of ``req`` into ``out`` (shape ``(row1-row0, n_dims)``)."""
         rows = np.arange(row0, row1, dtype=np.int64)
         n_s = len(req.samples)
-        p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
-        i = req.samples[rows % n_s][:, None]
-        j = req.dims[None, :]
         prm = req.params
+        i = req.samples[rows % n_s][:, None]
+        if uses_tables(req):
+            out[...] = self._tabled(req, rows, i)
+            return
+        p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
+        j = req.dims[None, :]
         if req.construction.name == "bose":
             out[...] = oa.bose(i, j, prm.s, p, req.offset, req.jitter)
         else:
             out[...] = oa.cmjnd(i, j, prm.s, prm.strength, p, req.offset, req.jitter)
+
+    @staticmethod
+    def _tabled(req: Request, rows: np.ndarray, i: np.ndarray) -> np.ndarray:
+        prm = req.params
+        s, M, dmax = prm.s, prm.M, prm.block_dims
+        n_s = len(req.samples)
+        pix0 = rows[0] // n_s
+        local = (rows // n_s - pix0)[:, None]  # pixel of each row, within this chunk
+        q = oa.column_key(pixel_seed(req.seed, req.pixels[pix0 : rows[-1] // n_s + 1])[:, None], req.dims[None, :], dmax)
+        strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])
+        col = (req.dims % U32(dmax))[None, :]
+        d = np.arange(req.n_dims)[None, :]
+        if req.construction.name == "bose":
+            aij, u = oa.bose_cell(i, col, s)
+        else:
+            aij, u = oa.cmjnd_cell(i, col, s)
+        if req.offset == "cmj":
+            subs = permute(np.arange(M, dtype=U32), M, (q * U32(SUBSTRATUM_KEY))[..., None])
+            sub = subs[local, d, u].astype(F32)
+        else:
+            sub = F32((M - 1) / 2)
+        return oa.oa_value(i, strata[local, d, aij], sub, (q * U32(JITTER_KEY))[local, d], M, s, req.jitter)

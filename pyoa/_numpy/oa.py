@@ -1,66 +1,77 @@
-"""Orthogonal-array samplers over NumPy arrays (mirrors :mod:`pyoa.reference.oa`).
+"""Orthogonal-array samplers over NumPy arrays (mirrors :mod:`pyoa.reference.oa`
+and, piece by piece, ``kernels/oa.cl``).
 
 Each function takes broadcastable arrays of sample indices ``i``, dimensions
 ``j`` (any ``j >= 0``; blocks per SPEC section 6) and array seeds ``p`` and
-returns float32 values; see the reference for the mathematics.
+returns float32 values; see the reference for the mathematics. The pieces
+(column key, cell, offset, value) are public to this package because the
+NumPy backend's table path (:mod:`.backend`) reuses them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import F32, jitter_value, sample_value
-from .hashes import U32, block_seed, dimension_seeds, permute, randfloat
+from .hashes import U32, block_seed, permute, randfloat
 
 
-def _blocks(j, p, block_dims: int):
+def column_key(p, j, dmax: int) -> np.ndarray:
+    """``block_seed(p, j // dmax) * (j % dmax + 1)``: times STRATUM_KEY,
+    SUBSTRATUM_KEY and JITTER_KEY it gives the dimension seeds."""
     j = np.asarray(j, dtype=U32)
-    block, col = j // U32(block_dims), j % U32(block_dims)
-    return col, block_seed(p, block)
+    return block_seed(p, j // U32(dmax)) * (j % U32(dmax) + U32(1))
+
+
+def bose_cell(i, col, s: int):
+    """``(A_ij, A_ik)`` of Bose column ``col < s+1`` and its partner column."""
+    i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
+    S = U32(s)
+    a0, a1 = i // S, i % S
+    k = np.where(col % U32(2) == 1, col - U32(1), col + U32(1))
+    aij = np.where(col == 0, a0, np.where(col == 1, a1, (a0 + (col - U32(1)) * a1) % S))
+    aik = np.where(col == 0, a1, np.where(col == 1, a0, (a0 + ((k - U32(1)) % S) * a1) % S))
+    return aij, aik
+
+
+def cmjnd_cell(i, col, s: int):
+    """``(A_ij, v)``: digit ``col`` of ``i`` in base ``s``, and the other digits."""
+    i = np.asarray(i, dtype=U32)
+    S = U32(s)
+    sj = S ** np.asarray(col, dtype=U32)  # s**col <= s**(t-1) < 2**24
+    return (i // sj) % S, i % sj + (i // (sj * S)) * sj
+
+
+def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
+    """The sub-stratum (float32) of each offset style; ``cell_key`` seeds ``j``."""
+    if offset == "centered":
+        return F32((M - 1) / 2)
+    seed = {"j": cell_key * P2, "mj": (aij + U32(1)) * P2, "cmj": P2}[offset]
+    return permute(u, M, seed).astype(F32)
+
+
+def oa_value(i, stratum, sub, P3, M: int, s: int, jitter: float) -> np.ndarray:
+    """``(stratum + (sub + jitter) / M) / s`` with the jitter of sample ``i``."""
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), F32(jitter)), M, s)
 
 
 def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bose` (parameters assumed valid)."""
-    i = np.asarray(i, dtype=U32)
-    j, p = _blocks(j, p, s + 1)
-    P1, P2, P3 = dimension_seeds(p, j)
-    S = U32(s)
-    a0, a1 = i // S, i % S
-    # Column multiplier of the Bose formula, and of the partner column k.
-    k = np.where(j % U32(2) == 1, j - U32(1), j + U32(1))
-    aij = np.where(j == 0, a0, np.where(j == 1, a1, (a0 + (j - U32(1)) * a1) % S))
-    aik = np.where(j == 0, a1, np.where(j == 1, a0, (a0 + ((k - U32(1)) % S) * a1) % S))
-
-    stratum = permute(aij, s, P1)
-    if offset == "centered":
-        sub = F32((s - 1) / 2)
-    elif offset == "j":
-        sub = permute(aik, s, (aik * S + aij + U32(1)) * P2)
-    elif offset == "mj":
-        sub = permute(aik, s, (aij + U32(1)) * P2)
-    else:
-        sub = permute(aik, s, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), F32(jitter)), s, s)
+    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
+    q = column_key(p, j, s + 1)
+    aij, aik = bose_cell(i, j % U32(s + 1), s)
+    stratum = permute(aij, s, q * U32(STRATUM_KEY))
+    sub = offset_sub(offset, aik, s, aik * U32(s) + aij + U32(1), aij, q * U32(SUBSTRATUM_KEY))
+    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), s, s, jitter)
 
 
 def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.cmjnd` (parameters assumed valid)."""
-    i = np.asarray(i, dtype=U32)
-    j, p = _blocks(j, p, t)
-    P1, P2, P3 = dimension_seeds(p, j)
-    S = U32(s)
+    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
+    q = column_key(p, j, t)
     M = s ** (t - 1)
-    sj = S ** j  # s**j <= s**(t-1) < 2**24: no overflow
-    aij = (i // sj) % S
-    v = i % sj + (i // (sj * S)) * sj
-
-    stratum = permute(aij, s, P1)
-    if offset == "centered":
-        sub = F32((M - 1) / 2)
-    elif offset == "j":
-        sub = permute(v, M, (i + U32(1)) * P2)
-    elif offset == "mj":
-        sub = permute(v, M, (aij + U32(1)) * P2)
-    else:
-        sub = permute(v, M, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), F32(jitter)), M, s)
+    aij, v = cmjnd_cell(i, j % U32(t), s)
+    stratum = permute(aij, s, q * U32(STRATUM_KEY))
+    sub = offset_sub(offset, v, M, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
+    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)
