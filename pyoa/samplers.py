@@ -18,6 +18,7 @@ import math
 import numbers
 import os
 import re
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -224,14 +225,33 @@ class Sampler:
         out = np.empty(shape, dtype=np.float32)
         rows = out.reshape(req.n_rows, req.n_dims)
         step = self._backend.rows_per_chunk(req.n_dims)
-        starts = range(0, req.n_rows, step)
-        if progress and len(starts) > 1:
+        chunks = [(r0, min(r0 + step, req.n_rows)) for r0 in range(0, req.n_rows, step)]
+        bar = None
+        if progress and len(chunks) > 1:
             from tqdm.auto import tqdm
 
-            starts = tqdm(starts, desc=f"pyoa {self.name}", unit="chunk")
-        for r0 in starts:
-            r1 = min(r0 + step, req.n_rows)
+            bar = tqdm(total=len(chunks), desc=f"pyoa {self.name}", unit="chunk")
+
+        def fill(chunk):
+            r0, r1 = chunk
             self._backend.fill(req, r0, r1, rows[r0:r1])
+            if bar is not None:
+                bar.update()
+
+        # Backends whose fill runs on the host without a lock (NumPy releases
+        # the GIL inside its ufuncs) fill chunks on every core; chunks write
+        # disjoint rows of `out`, so no further synchronisation is needed.
+        workers = min(len(chunks), os.cpu_count() or 1) if self._backend.parallel_chunks else 1
+        try:
+            if workers > 1:
+                with ThreadPoolExecutor(workers) as pool:
+                    list(pool.map(fill, chunks))
+            else:
+                for chunk in chunks:
+                    fill(chunk)
+        finally:
+            if bar is not None:
+                bar.close()
         return out
 
     def value(self, pixel: int, i: int, j: int) -> float:

@@ -35,6 +35,8 @@ class NumpyBackend:
     """Vectorized evaluation of :mod:`pyoa._numpy.oa`; stateless, so thread-safe."""
 
     name = "numpy"
+    #: Sampler.generate may call fill on several chunks at once (one per core).
+    parallel_chunks = True
 
     def describe(self) -> str:
         return f"NumPy {np.__version__} on the CPU"

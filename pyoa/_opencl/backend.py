@@ -28,6 +28,8 @@ class OpenCLBackend:
     """
 
     name = "opencl"
+    #: Launches are serialized by a lock; the device parallelizes inside one.
+    parallel_chunks = False
 
     def __init__(self, selector: str | None = None):
         self.info: DeviceInfo = select_device(selector)
