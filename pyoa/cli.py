@@ -15,6 +15,7 @@ import numpy as np
 
 from . import OFFSETS, backends, sampler, samplers, valid_spp
 from .atomic import atomic_path
+from .backends import BackendUnavailable
 
 FORMATS = (".npy", ".csv")
 
@@ -124,7 +125,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, TypeError, FileNotFoundError) as exc:
+    except (ValueError, TypeError, FileNotFoundError, BackendUnavailable) as exc:
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
 
 

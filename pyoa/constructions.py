@@ -96,6 +96,16 @@ def integer_root(n: int, t: int) -> int | None:
     return None
 
 
+def integer_root_floor(n: int, t: int) -> int:
+    """The largest s with ``s**t <= n``."""
+    s = int(round(n ** (1.0 / t)))
+    while s**t > n:
+        s -= 1
+    while (s + 1) ** t <= n:
+        s += 1
+    return s
+
+
 def nearest(choices: list[SppChoice], spp: int, k: int = 2) -> list[SppChoice]:
     """The ``k`` choices closest to ``spp`` (ties broken towards fewer samples),
     returned in increasing order of sample count."""
@@ -124,6 +134,10 @@ class Construction:
     def resolve(self, spp: int, dims: int, strength: int | None) -> Params:
         raise NotImplementedError
 
+    def nearest(self, spp: int, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
+        """The two valid counts closest to ``spp``."""
+        return nearest(self.choices(dims=dims, strength=strength), spp)
+
 
 class Bose(Construction):
     """Bose (1938): strength 2, s prime, N = s**2, s+1 dimensions per block."""
@@ -147,7 +161,7 @@ class Bose(Construction):
             )
         s = math.isqrt(spp)
         if s * s != spp or not is_prime(s) or s > self.max_s:
-            near = _labels(nearest(self.choices(), spp))
+            near = _labels(self.nearest(spp))
             raise ValueError(f"bose: {spp} is not s^2 with s prime (s <= {self.max_s}); nearest: {near}")
         return Params(s=s, strength=2, block_dims=s + 1, M=s)
 
@@ -169,6 +183,18 @@ class CMJND(Construction):
             return [1]
         return list(range(2, min(dims, self.max_strength) + 1))
 
+    def nearest(self, spp, dims=None, strength=None):
+        # Only the few s around spp**(1/t) of each strength can be nearest;
+        # enumerating every count (16.7 million at t = 1) took half a minute.
+        cands = []
+        for t in self._strengths(dims, strength):
+            root = int(round(max(spp, 1) ** (1.0 / t)))
+            s_max = integer_root_floor(MAX_SPP, t)
+            for s in {*range(max(2, root - 2), root + 3), s_max}:
+                if 2 <= s <= s_max:
+                    cands.append(SppChoice(s**t, s, t, t))
+        return nearest(cands, spp)
+
     def choices(self, dims=None, strength=None):
         out = []
         for t in self._strengths(dims, strength):
@@ -184,7 +210,7 @@ class CMJND(Construction):
                 raise ValueError(f"cmjnd strength must be an integer in [1, {self.max_strength}], got {strength}")
             s = integer_root(spp, strength)
             if s is None or s < 2:
-                near = _labels(nearest(self.choices(strength=strength), spp))
+                near = _labels(self.nearest(spp, strength=strength))
                 raise ValueError(f"cmjnd: {spp} is not s^{strength} with s >= 2; nearest: {near}")
             return Params(s=s, strength=strength, block_dims=strength, M=spp // s)
         # No strength given: the largest t <= dims (t >= 2 unless dims == 1)
@@ -194,7 +220,7 @@ class CMJND(Construction):
             if s is not None and s >= 2:
                 return Params(s=s, strength=t, block_dims=t, M=spp // s)
         ts = self._strengths(dims, None)
-        near = _labels(nearest(self.choices(dims=dims), spp))
+        near = _labels(self.nearest(spp, dims=dims))
         raise ValueError(
             f"cmjnd: {spp} is not s^t with s >= 2 for any strength {ts[0]} <= t <= {ts[-1]} "
             f"(dims={dims}); nearest: {near}"
@@ -240,7 +266,7 @@ def valid_spp(name: str, near: int | None = None, dims: int | None = None, stren
     >>> [c.label() for c in valid_spp("bose", near=120)]
     ['121 (s=11)', '169 (s=13)']
     """
-    choices = get(name).choices(dims=dims, strength=strength)
+    construction = get(name)
     if near is None:
-        return choices
-    return nearest(choices, int(near))
+        return construction.choices(dims=dims, strength=strength)
+    return construction.nearest(int(near), dims=dims, strength=strength)

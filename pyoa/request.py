@@ -35,3 +35,25 @@ class Request:
     @property
     def n_dims(self) -> int:
         return len(self.dims)
+
+    @property
+    def table_entries(self) -> int:
+        """Entries per (pixel, dimension) of the table path: ``s`` stratum
+        permutation entries, ``M`` sub-stratum entries (``cmj`` only) and the
+        jitter seed (the layout of ``kernels/generate.cl``)."""
+        return self.params.s + (self.params.M if self.offset == "cmj" else 0) + 1
+
+    def tables_pay_off(self, row0: int, row1: int) -> bool:
+        """Whether rows ``[row0, row1)`` should use the table path.
+
+        The table path (``cmj`` and ``centered`` only) first computes
+        :attr:`table_entries` values per (pixel, dimension) for every pixel the
+        rows touch, then gathers. It pays off when that table is no larger than the
+        chunk's output; the same bound keeps the table buffer within the
+        chunk size limits the backends already respect.
+        """
+        if self.offset not in ("cmj", "centered") or row1 <= row0:
+            return False
+        n_s = len(self.samples)
+        n_pixels = (row1 - 1) // n_s - row0 // n_s + 1
+        return n_pixels * self.table_entries <= row1 - row0

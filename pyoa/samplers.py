@@ -84,7 +84,10 @@ def _indices(name: str, value, size: int, default) -> np.ndarray:
     if value is None:
         value = default
     if isinstance(value, range):
-        if len(value) and not (0 <= min(value[0], value[-1]) and max(value[0], value[-1]) < size):
+        # Check the end points, not len(): len() of a range with 2**63 or
+        # more elements raises OverflowError. In-bounds end points bound the
+        # length by `size`.
+        if value and not (0 <= min(value[0], value[-1]) and max(value[0], value[-1]) < size):
             raise ValueError(f"{name} must lie in [0, {size}), got {value}")
         return np.arange(value.start, value.stop, value.step, dtype=np.int64).astype(np.uint32)
     if isinstance(value, (str, bytes)) or np.isscalar(value) or not hasattr(value, "__len__"):

@@ -20,17 +20,6 @@ from .hashes import U32, permute, pixel_seed
 CHUNK_VALUES = 1 << 20
 
 
-def table_entries(req: Request) -> int:
-    """Permutation entries per (pixel, dimension) of the table path: s strata,
-    plus M sub-strata for ``cmj``."""
-    return req.params.s + (req.params.M if req.offset == "cmj" else 0)
-
-
-def uses_tables(req: Request) -> bool:
-    """Tables pay off when they are no longer than the samples asked per pixel."""
-    return req.offset in ("cmj", "centered") and table_entries(req) < len(req.samples)
-
-
 class NumpyBackend:
     """Vectorized evaluation of :mod:`pyoa._numpy.oa`; stateless, so thread-safe."""
 
@@ -50,7 +39,7 @@ class NumpyBackend:
         n_s = len(req.samples)
         prm = req.params
         i = req.samples[rows % n_s][:, None]
-        if uses_tables(req):
+        if req.tables_pay_off(row0, row1):
             out[...] = self._tabled(req, rows, i)
             return
         p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]

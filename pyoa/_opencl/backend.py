@@ -47,16 +47,6 @@ class OpenCLBackend:
     def rows_per_chunk(self, n_dims: int) -> int:
         return max(1, self.max_chunk_values // max(1, n_dims))
 
-    def _uses_tables(self, req: Request) -> bool:
-        """The table path pays off when a table (E entries per pixel and
-        dimension) is no longer than the samples asked of that pixel."""
-        return req.offset in ("cmj", "centered") and self._table_entries(req) <= len(req.samples)
-
-    @staticmethod
-    def _table_entries(req: Request) -> int:
-        prm = req.params
-        return prm.s + (prm.M if req.offset == "cmj" else 0) + 1
-
     def fill(self, req: Request, row0: int, row1: int, out: np.ndarray) -> None:
         """Write rows ``[row0, row1)`` of ``req`` into ``out`` (C-contiguous float32)."""
         import pyopencl as cl
@@ -75,8 +65,8 @@ class OpenCLBackend:
             # Only the pixels of these rows travel to the device.
             pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
             pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
-            if self._uses_tables(req):
-                E = self._table_entries(req)
+            if req.tables_pay_off(row0, row1):
+                E = req.table_entries
                 n_entries = (pix1 - pix0) * req.n_dims * E
                 tab = cl.Buffer(self.context, mf.READ_WRITE, size=n_entries * 4)
                 self._kernels["tables"](

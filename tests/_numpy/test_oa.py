@@ -1,0 +1,55 @@
+"""The NumPy OA functions (pyoa._numpy.oa), called directly: seed 0 (the canonical
+array, which no Sampler pixel reaches), broadcasting, against the reference and C."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pyoa import reference as ref
+from pyoa._numpy import oa as noa
+from tests.helpers import U32_MAX, assert_same_bits
+
+U32 = np.uint32
+
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+@pytest.mark.parametrize("p", [0, 1, U32_MAX])
+@pytest.mark.parametrize("s", [2, 5, 13])
+def test_bose_equals_reference_including_seed_zero(s, p, offset):
+    i = np.arange(s * s, dtype=U32)[:, None]
+    j = np.arange(2 * (s + 1) + 1, dtype=U32)[None, :]
+    for J in (1.0, 0.0, 0.3):
+        got = noa.bose(i, j, s, U32(p), offset, J)
+        want = np.array([[ref.bose(a, b, s, p, offset, J) for b in range(j.size)] for a in range(i.size)], np.float32)
+        assert_same_bits(got, want, f"bose s={s} p={p} {offset} J={J}")
+
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+@pytest.mark.parametrize("p", [0, 0xDEADBEEF])
+@pytest.mark.parametrize("s, t", [(2, 1), (3, 3), (4, 2), (2, 5)])
+def test_cmjnd_equals_reference_including_seed_zero(s, t, p, offset):
+    i = np.arange(s**t, dtype=U32)[:, None]
+    j = np.arange(2 * t + 1, dtype=U32)[None, :]
+    got = noa.cmjnd(i, j, s, t, U32(p), offset, 0.75)
+    want = np.array([[ref.cmjnd(a, b, s, t, p, offset, 0.75) for b in range(j.size)] for a in range(i.size)], np.float32)
+    assert_same_bits(got, want, f"cmjnd s={s} t={t} p={p} {offset}")
+
+
+def test_per_lane_seeds_broadcast():
+    """Different seeds per row (pixels) give the reference value of each."""
+    s = 7
+    p = np.array([0, 1, 99, U32_MAX], dtype=U32)[:, None]
+    i = np.array([0, 5, 48, 17], dtype=U32)[:, None]
+    j = np.array([0, 3, 8, 9], dtype=U32)[None, :]
+    got = noa.bose(i, j, s, p, "mj", 1.0)
+    want = np.array([[ref.bose(int(a), int(b), s, int(q), "mj") for b in j[0]] for a, q in zip(i[:, 0], p[:, 0])], np.float32)
+    assert_same_bits(got, want)
+
+
+def test_c_oracle_agrees_on_seed_zero(spec_c):
+    for off in ("cmj", "j"):
+        rows = [(i, j, 5, 0, off, 1.0) for i in range(25) for j in range(9)]
+        want = np.array(spec_c.bose_bits(rows), dtype=np.uint32).view(np.float32).reshape(25, 9)
+        got = noa.bose(np.arange(25, dtype=U32)[:, None], np.arange(9, dtype=U32)[None, :], 5, U32(0), off, 1.0)
+        assert_same_bits(got, want, off)

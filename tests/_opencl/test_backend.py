@@ -1,0 +1,54 @@
+"""The OpenCL backend (pyoa._opencl.backend): launches, tables and buffer sizes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import pyoa
+from tests.helpers import assert_same_bits
+
+pytestmark = pytest.mark.opencl
+
+
+def test_chunk_limit_respects_device(opencl):
+    from pyoa._opencl.backend import MAX_CHUNK_BYTES
+
+    dev = opencl.info.device
+    assert 0 < opencl.max_chunk_values * 4 <= min(MAX_CHUNK_BYTES, dev.max_mem_alloc_size, 2**31 - 1)
+
+
+def test_no_device_buffer_exceeds_the_chunk_limit(monkeypatch, opencl):
+    """Every device allocation of one launch (output chunk, permutation tables) must
+    stay within the backend's chunk limit, which is how it honours the device's
+    CL_DEVICE_MAX_MEM_ALLOC_SIZE. The permutation tables of the `cmj` path are
+    n_pixels x n_dims x (s + M + 1) uint32 and are not bounded by it: on PoCL
+    (max alloc 2 GiB) cmjnd spp=2^24, dims=64 fails with INVALID_BUFFER_SIZE
+    although every output chunk is 256 MiB. Here the same with a small limit."""
+    import pyopencl as cl
+
+    sizes = []
+    real = cl.Buffer
+
+    def recording(ctx, flags, size=0, hostbuf=None):
+        nbytes = hostbuf.nbytes if hostbuf is not None else size
+        sizes.append(nbytes)
+        return real(ctx, flags, size, hostbuf) if hostbuf is not None else real(ctx, flags, size)
+
+    smp = pyoa.sampler("bose", spp=169, dims=100, seed=1, backend="opencl")  # cmj: tables of 27 entries
+    want = pyoa.sampler("bose", spp=169, dims=100, seed=1, backend="numpy").generate(pixels=[0])
+    limit_values = 2000
+    monkeypatch.setattr(smp._backend, "max_chunk_values", limit_values)
+    monkeypatch.setattr(cl, "Buffer", recording)
+    got = smp.generate(pixels=[0])
+    assert_same_bits(got, want)
+    assert max(sizes) <= 4 * limit_values, f"largest device buffer {max(sizes)} B > chunk limit {4 * limit_values} B"
+
+
+def test_tables_and_direct_kernels_agree(opencl):
+    for offset in ("cmj", "centered"):
+        smp = pyoa.sampler("bose", spp=121, dims=25, seed=6, offset=offset, backend="opencl")
+        full = smp.generate(pixels=[0, 2**32 - 1])  # table kernels
+        few = np.concatenate([smp.generate(pixels=[0, 2**32 - 1], samples=range(k, min(k + 10, 121)))
+                              for k in range(0, 121, 10)], axis=1)  # 10 samples: direct kernel
+        assert_same_bits(full, few, offset)

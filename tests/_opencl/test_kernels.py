@@ -1,0 +1,163 @@
+"""The OpenCL C functions of kernels/*.cl, called one by one through a small test
+kernel built with pyoa's own source and build options, against the C oracle."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pyoa._opencl import program as prog
+from tests.helpers import U32_MAX, assert_same_bits, permute_cases, randfloat_cases, seed_pair_cases
+
+pytestmark = pytest.mark.opencl
+U32 = np.uint32
+
+TEST_KERNELS = r"""
+__kernel void t_permute(__global const uint *i, __global const uint *l, __global const uint *p, __global uint *out)
+{ size_t g = get_global_id(0); out[g] = permute(i[g], l[g], p[g]); }
+
+__kernel void t_randfloat(__global const uint *i, __global const uint *p, __global float *out)
+{ size_t g = get_global_id(0); out[g] = randfloat(i[g], p[g]); }
+
+__kernel void t_seeds(__global const uint *a, __global const uint *b, __global uint *mix,
+                      __global uint *pix, __global uint *blk)
+{ size_t g = get_global_id(0); mix[g] = mix32(a[g]); pix[g] = pixel_seed(a[g], b[g]); blk[g] = block_seed(a[g], b[g]); }
+
+__kernel void t_sample_value(__global const uint *stratum, __global const float *sub, __global const float *jit,
+                             const uint M, const uint s, __global float *out)
+{ size_t g = get_global_id(0); out[g] = sample_value(stratum[g], sub[g], jit[g], M, s); }
+
+__kernel void t_jitter_value(__global const float *r, const float J, __global float *out)
+{ size_t g = get_global_id(0); out[g] = jitter_value(r[g], J); }
+
+__kernel void t_bose(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
+                     const uint offset, const float J, __global float *out)
+{ size_t g = get_global_id(0); out[g] = bose(i[g], j[g], s, p[g], offset, J); }
+
+__kernel void t_cmjnd(__global const uint *i, __global const uint *j, const uint s, const uint t,
+                      __global const uint *p, const uint offset, const float J, __global float *out)
+{ size_t g = get_global_id(0); out[g] = cmjnd(i[g], j[g], s, t, p[g], offset, J); }
+"""
+
+
+@pytest.fixture(scope="module")
+def harness(opencl):
+    import pyopencl as cl
+
+    ctx, queue = opencl.context, opencl.queue
+    program = cl.Program(ctx, prog.source() + "\n" + TEST_KERNELS).build(options=prog.BUILD_OPTIONS + prog.defines())
+
+    kernels = {}
+
+    def run(name, outs, *args):
+        mf = cl.mem_flags
+        n = None
+        kargs = []
+        for a in args:
+            if isinstance(a, np.ndarray):
+                n = a.size if n is None else n
+                assert a.size == n
+                kargs.append(cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a)))
+            else:
+                kargs.append(a)
+        results = [np.empty(n, dtype=dt) for dt in outs]
+        bufs = [cl.Buffer(ctx, mf.WRITE_ONLY, size=max(4, r.nbytes)) for r in results]
+        if name not in kernels:
+            kernels[name] = cl.Kernel(program, name)
+        kernels[name](queue, (n,), None, *kargs, *bufs)
+        for r, b in zip(results, bufs):
+            cl.enqueue_copy(queue, r, b)
+        queue.finish()
+        return results if len(results) > 1 else results[0]
+
+    return run
+
+
+def test_permute_matches_c_oracle(harness, spec_c):
+    cases = permute_cases()
+    i, l, p = (np.array(v, dtype=U32) for v in zip(*cases))
+    got = harness("t_permute", [U32], i, l, p)
+    assert got.tolist() == spec_c.permute(*zip(*cases))
+
+
+@pytest.mark.parametrize("l", [3, 4093, 2**23])
+def test_permute_bijection(harness, l):
+    for p in (0x9E3779B9, U32_MAX, U32_MAX - (l - 1)):
+        got = harness("t_permute", [U32], np.arange(l, dtype=U32), np.full(l, l, U32), np.full(l, p, U32))
+        assert np.array_equal(np.sort(got), np.arange(l, dtype=U32)), (l, p)
+
+
+def test_randfloat_bits_match_c_oracle(harness, spec_c):
+    cases = randfloat_cases()
+    i, p = (np.array(v, dtype=U32) for v in zip(*cases))
+    got = harness("t_randfloat", [np.float32], i, p)
+    assert got.view(U32).tolist() == spec_c.randfloat_bits(*zip(*cases))
+
+
+def test_seed_hashes_match_c_oracle(harness, spec_c):
+    cases = seed_pair_cases()
+    a, b = (np.array(v, dtype=U32) for v in zip(*cases))
+    mix, pix, blk = harness("t_seeds", [U32, U32, U32], a, b)
+    A, B = zip(*cases)
+    assert mix.tolist() == spec_c.mix32(A)
+    assert pix.tolist() == spec_c.pixel_seed(A, B)
+    assert blk.tolist() == spec_c.block_seed(A, B)
+
+
+def test_sample_value_clamps_below_one(harness):
+    """stratum s-1, sub M-1, jitter just below 1: the exact result rounds to 1.0 and
+    must become 0x3f7fffff (SPEC section 7)."""
+    from pyoa.reference.floats import sample_value
+
+    jit = np.float32(1) - np.float32(2**-24)  # 0x3f7fffff
+    cases = [(3, 3), (7, 49), (13, 13), (2, 2**23), (4093, 4093)]
+    for s, M in cases:
+        got = harness("t_sample_value", [np.float32], np.array([s - 1], U32), np.array([M - 1], np.float32),
+                      np.array([jit], np.float32), U32(M), U32(s))
+        want = np.float32(sample_value(s - 1, M - 1, float(jit), M, s))
+        assert got.view(U32)[0] == want.view(U32) == 0x3F7FFFFF, (s, M)
+
+
+def test_jitter_value_has_no_fused_multiply_add(harness):
+    """0.5 + J * (r - 0.5) with two roundings; an FMA would differ for some inputs."""
+    from pyoa.reference.floats import jitter_value
+
+    rng = np.random.default_rng(11)
+    r = rng.random(20000).astype(np.float32)
+    for J in (0.1, 0.3, 0.7, 0.9999):
+        got = harness("t_jitter_value", [np.float32], r, np.float32(J))
+        want = np.array([jitter_value(float(x), float(np.float32(J))) for x in r], np.float32)
+        assert_same_bits(got, want, f"J={J}")
+        fused = (np.float64(0.5) + np.float64(np.float32(J)) * (r - np.float32(0.5)).astype(np.float64)).astype(np.float32)
+        assert np.any(fused.view(U32) != want.view(U32)), "inputs do not distinguish an FMA"
+
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+def test_bose_and_cmjnd_match_c_oracle_including_seed_zero(harness, spec_c, offset):
+    code = {"centered": 0, "j": 1, "mj": 2, "cmj": 3}[offset]
+    rng = np.random.default_rng(code)
+    for s in (2, 3, 13, 4093):
+        n = 400
+        i = rng.integers(0, s * s, n).astype(U32)
+        j = rng.integers(0, 3 * (s + 1), n).astype(U32)
+        p = rng.choice(np.array([0, 1, U32_MAX, 0x12345678, 0x9E3779B9], U32), n)
+        J = 0.625
+        got = harness("t_bose", [np.float32], i, j, U32(s), p, U32(code), np.float32(J))
+        want = spec_c.bose_bits([(a, b, s, c, offset, J) for a, b, c in zip(i, j, p)])
+        assert got.view(U32).tolist() == want, f"bose s={s}"
+    for s, t in ((2, 1), (3, 4), (2, 24), (4096, 2), (5, 3)):
+        n = 300
+        i = rng.integers(0, s**t, n).astype(U32)
+        j = rng.integers(0, 3 * t, n).astype(U32)
+        p = rng.choice(np.array([0, 1, U32_MAX, 0x12345678], U32), n)
+        got = harness("t_cmjnd", [np.float32], i, j, U32(s), U32(t), p, U32(code), np.float32(1.0))
+        want = spec_c.cmjnd_bits([(a, b, s, t, c, offset, 1.0) for a, b, c in zip(i, j, p)])
+        assert got.view(U32).tolist() == want, f"cmjnd s={s} t={t}"
+
+
+def test_build_options_keep_floats_exact():
+    opts = " ".join(prog.BUILD_OPTIONS)
+    assert "-cl-fp32-correctly-rounded-divide-sqrt" in opts
+    for bad in ("-cl-fast-relaxed-math", "-cl-mad-enable", "-cl-unsafe-math-optimizations"):
+        assert bad not in opts
+    assert "#pragma OPENCL FP_CONTRACT OFF" in prog.source()

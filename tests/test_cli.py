@@ -1,0 +1,225 @@
+"""The command line (pyoa.cli): files equal to the API bit for bit, errors exit 2,
+writes are atomic."""
+
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import pyoa
+from pyoa import cli
+from tests.helpers import assert_same_bits
+
+
+def run_cli(args, capsys):
+    """Run ``pyoa ARGS`` in-process: (exit status, stdout, stderr)."""
+    try:
+        code = cli.main([str(a) for a in args])
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def leftovers(folder, name):
+    return [p for p in os.listdir(folder) if p != name and name in p]
+
+
+POINTS = ["points", "--sampler", "cmjnd", "--spp", "125", "--strength", "3", "--dims", "7", "--pixels", "3",
+          "--pixel0", "4294967293", "--seed", "11", "--offset", "mj", "--jitter", "0.75", "-q"]
+
+
+def api_points(backend):
+    s = pyoa.sampler("cmjnd", spp=125, strength=3, dims=7, seed=11, offset="mj", jitter=0.75, backend=backend)
+    return s.generate(pixels=range(4294967293, 4294967296))
+
+
+def test_points_npy(tmp_path, capsys, backend):
+    out = tmp_path / "x.npy"
+    code, stdout, _ = run_cli(POINTS + ["--backend", backend, "--out", out], capsys)
+    assert code == 0 and stdout == ""  # -q prints nothing
+    x = np.load(out)
+    assert x.dtype == np.float32 and x.shape == (3, 125, 7)
+    assert_same_bits(x, api_points(backend))
+    assert leftovers(tmp_path, "x.npy") == []
+
+
+def test_points_csv(tmp_path, capsys):
+    out = tmp_path / "x.CSV"  # extension check is case-insensitive
+    code, _, _ = run_cli(POINTS + ["--out", out], capsys)
+    assert code == 0
+    with open(out, newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0] == ["pixel", "sample"] + [f"x{d}" for d in range(7)]
+    body = rows[1:]
+    assert len(body) == 3 * 125
+    want = api_points("numpy")
+    pix = np.array([int(r[0]) for r in body])
+    smp = np.array([int(r[1]) for r in body])
+    assert np.array_equal(pix, np.repeat([4294967293, 4294967294, 4294967295], 125))
+    assert np.array_equal(smp, np.tile(np.arange(125), 3))
+    vals = np.array([[float(v) for v in r[2:]] for r in body])
+    # decimal text round-trips to the same float32 bits
+    assert_same_bits(vals.astype(np.float32).reshape(3, 125, 7), want)
+
+
+def test_points_default_sampler_and_verbose_output(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, stdout, _ = run_cli(["points", "--backend", "numpy"], capsys)
+    assert code == 0
+    x = np.load(tmp_path / "points.npy")
+    assert_same_bits(x, pyoa.sampler("bose", spp=121, dims=8, backend="numpy").generate())
+    assert "Sampler('bose'" in stdout and "points.npy" in stdout and "968 values" in stdout
+
+
+@pytest.mark.parametrize("name", ["x.txt", "x", "x.npz", "x.npy.bak"])
+def test_bad_extension_exits_2(tmp_path, capsys, name):
+    code, _, err = run_cli(["points", "--spp", "9", "--dims", "2", "--out", tmp_path / name, "-q"], capsys)
+    assert code == 2
+    assert "--out must end in .npy or .csv" in err and "error" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_bad_spp_exits_2(tmp_path, capsys):
+    code, _, err = run_cli(["points", "--spp", "120", "--out", tmp_path / "x.npy"], capsys)
+    assert code == 2
+    assert "121 (s=11)" in err and "169 (s=13)" in err and "Traceback" not in err
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--seed", "-1"], ["seed"]),
+    (["--jitter", "2"], ["jitter"]),
+    (["--sampler", "sobol"], ["sobol"]),
+    (["--dims", "0"], ["dims"]),
+    (["--pixel0", "4294967295", "--pixels", "2"], ["pixels"]),
+])
+def test_bad_values_exit_2(tmp_path, capsys, args, words):
+    code, _, err = run_cli(["points", "--spp", "9", "--out", tmp_path / "x.npy", "-q"] + args, capsys)
+    assert code == 2
+    for w in words:
+        assert w in err
+
+
+def test_bad_choice_exits_2(tmp_path, capsys):
+    code, _, err = run_cli(["points", "--offset", "diagonal", "--out", tmp_path / "x.npy"], capsys)
+    assert code == 2 and "diagonal" in err
+
+
+def test_missing_directory_exits_2(tmp_path, capsys):
+    code, _, err = run_cli(["points", "--spp", "9", "--out", tmp_path / "nope" / "x.npy", "-q"], capsys)
+    assert code == 2 and "does not exist" in err
+
+
+# ----------------------------------------------------------------------------- atomic writes
+
+def _good_file(path):
+    path.write_bytes(b"GOOD OLD CONTENT")
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("exc", [OSError("disk full"), KeyboardInterrupt()])
+def test_failed_npy_write_leaves_old_file(tmp_path, capsys, monkeypatch, exc):
+    out = tmp_path / "x.npy"
+    old = _good_file(out)
+    seen = []
+
+    def half_save(file, arr, *a, **k):
+        seen.append(str(file))
+        with open(file, "wb") as fh:
+            fh.write(b"\x93NUMPY half")
+        raise exc
+
+    monkeypatch.setattr(np, "save", half_save)
+    with pytest.raises(type(exc)):
+        cli.main(["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", str(out), "-q"])
+    assert seen and seen[0] != str(out)  # it wrote elsewhere first
+    assert out.read_bytes() == old
+    assert leftovers(tmp_path, "x.npy") == [], os.listdir(tmp_path)
+
+
+def test_failed_csv_write_leaves_old_file(tmp_path, monkeypatch):
+    out = tmp_path / "x.csv"
+    old = _good_file(out)
+
+    def half_savetxt(fh, arr, *a, **k):
+        fh.write("0,0,0.5\n")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savetxt", half_savetxt)
+    with pytest.raises(OSError, match="disk full"):
+        cli.main(["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", str(out), "-q"])
+    assert out.read_bytes() == old
+    assert leftovers(tmp_path, "x.csv") == []
+
+
+def test_successful_write_replaces_old_file(tmp_path, capsys):
+    out = tmp_path / "x.npy"
+    _good_file(out)
+    code, _, _ = run_cli(["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", out, "-q"], capsys)
+    assert code == 0
+    assert np.load(out).shape == (1, 9, 2)
+
+
+# ----------------------------------------------------------------------------- other commands
+
+def test_samplers_command(capsys):
+    code, out, _ = run_cli(["samplers"], capsys)
+    assert code == 0
+    assert out.split()[0] == "bose" and "\ncmjnd" in out
+
+
+def test_spp_command(capsys):
+    code, out, _ = run_cli(["spp", "bose", "--near", "120"], capsys)
+    assert code == 0
+    lines = out.strip().splitlines()
+    assert lines[0].split() == ["spp", "s", "t", "dims/block"]
+    assert [ln.split() for ln in lines[1:]] == [["121", "11", "2", "12"], ["169", "13", "2", "14"]]
+    code, out, _ = run_cli(["spp", "cmjnd", "--strength", "3", "--limit", "3"], capsys)
+    assert code == 0 and "8     2   3" in out and "more" in out
+    code, _, err = run_cli(["spp", "sobol"], capsys)
+    assert code == 2 and "sobol" in err
+
+
+def test_backends_command(capsys):
+    code, out, _ = run_cli(["backends"], capsys)
+    assert code == 0
+    assert "numpy" in out and "opencl" in out and "PYOA_BACKEND" in out
+    assert sum(line.startswith("*") for line in out.splitlines()) == 1
+
+
+def test_module_entry_point(tmp_path):
+    out = tmp_path / "y.npy"
+    env = {k: v for k, v in os.environ.items() if k != "PYOA_BACKEND"}
+    res = subprocess.run([sys.executable, "-m", "pyoa", "points", "--spp", "25", "--dims", "3", "--backend", "numpy",
+                          "--out", str(out), "-q"], capture_output=True, text=True, env=env, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert_same_bits(np.load(out), pyoa.sampler("bose", spp=25, dims=3, backend="numpy").generate())
+    res = subprocess.run([sys.executable, "-m", "pyoa", "points", "--spp", "24", "--out", str(out)],
+                         capture_output=True, text=True, env=env, timeout=120)
+    assert res.returncode == 2 and "25 (s=5)" in res.stderr
+
+
+def test_unusable_explicit_backend_exits_2(tmp_path, capsys, monkeypatch):
+    """`--backend opencl` where OpenCL cannot be used is a user-facing error: exit
+    status 2 and a one-line message, like a bad --spp (not a traceback)."""
+    import importlib
+
+    import pyoa._opencl.backend as ocl
+
+    B = importlib.import_module("pyoa.backends")
+
+    def broken(*a, **k):
+        raise RuntimeError("simulated: no OpenCL platform")
+
+    monkeypatch.setattr(ocl, "OpenCLBackend", broken)
+    monkeypatch.setattr(B, "_opencl", {})
+    code, _, err = run_cli(["points", "--spp", "9", "--backend", "opencl", "--out", tmp_path / "x.npy", "-q"], capsys)
+    assert code == 2
+    assert "simulated: no OpenCL platform" in err
+    assert os.listdir(tmp_path) == []

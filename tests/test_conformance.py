@@ -1,0 +1,259 @@
+"""SPEC section 8.4: every (pixel, sample, dimension) has the same float32 bits
+whichever backend computes it (OpenCL kernel == NumPy == pure-Python reference),
+in any batch. One suite over every sampler and backend: the ``backend`` fixture
+runs each test for "numpy" and "opencl"."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import example, given
+from hypothesis import strategies as st
+
+import pyoa
+from pyoa import reference as ref
+from pyoa._numpy import hashes as nh
+from tests.helpers import (
+    BOSE_PRIMES,
+    PIXEL_KEY,
+    U32_MAX,
+    assert_same_bits,
+    bits,
+    reference_block,
+)
+
+OFFSETS = ["centered", "j", "mj", "cmj"]
+SMALL_BOSE = [2, 3, 5, 7, 11, 13]
+
+
+def zero_hash_pixel(seed: int) -> int:
+    """The pixel whose raw pixel hash is 0 (pixel_seed must remap it): mix32 is a
+    bijection with mix32(0) == 0, so pixel = mix32(seed ^ key) gives 0."""
+    return ref.mix32(seed ^ PIXEL_KEY)
+
+
+def max_s(t: int) -> int:
+    s = int(round(2 ** (24 / t)))
+    while s**t > 2**24:
+        s -= 1
+    while (s + 1) ** t <= 2**24:
+        s += 1
+    return s
+
+
+@st.composite
+def configs(draw):
+    name = draw(st.sampled_from(["bose", "cmjnd"]))
+    if name == "bose":
+        s = draw(st.sampled_from(SMALL_BOSE) | st.sampled_from(BOSE_PRIMES))
+        t, spp, block = 2, s * s, s + 1
+    else:
+        t = draw(st.integers(1, 24))
+        hi = max_s(t)
+        s = draw(st.integers(2, min(hi, 8)) | st.integers(2, hi) | st.just(hi))
+        spp, block = s**t, t
+    dims = draw(st.integers(1, block) | st.integers(block, 4 * block + 1))
+    seed = draw(st.sampled_from([0, 1, U32_MAX, U32_MAX - 1]) | st.integers(0, U32_MAX))
+    offset = draw(st.sampled_from(OFFSETS))
+    # amounts with many significant bits make jitter_value's product inexact, so a
+    # fused multiply-add would change the bits
+    jitter = draw(st.sampled_from([0.0, 1.0]) | st.floats(0.0, 1.0)
+                  | st.integers(1, 2**24 - 1).map(lambda k: k * 2.0**-24))
+    many = draw(st.booleans())  # many samples per pixel: the backends' table paths (cmj, centered)
+    pixels = draw(st.lists(st.sampled_from([0, U32_MAX, zero_hash_pixel(seed)]) | st.integers(0, U32_MAX),
+                           min_size=1, max_size=2 if many else 3))
+    if many:
+        n = min(spp, draw(st.integers(1, 300)))
+        start = draw(st.integers(0, spp - n))
+        samples = list(range(start, start + n))
+        if draw(st.booleans()):
+            samples = samples[::-1]
+    else:
+        samples = draw(st.lists(st.sampled_from([0, spp - 1]) | st.integers(0, spp - 1), min_size=1, max_size=6))
+    samples.append(spp - 1)  # always the last sample
+    dim_idx = draw(st.lists(st.integers(0, dims - 1), min_size=0, max_size=6))
+    dim_idx.append(dims - 1)  # always the last dimension
+    return dict(name=name, s=s, t=t, spp=spp, dims=dims, seed=seed, offset=offset, jitter=jitter,
+                pixels=pixels, samples=samples, dim_idx=dim_idx)
+
+
+def make_sampler(cfg, backend):
+    return pyoa.sampler(cfg["name"], spp=cfg["spp"], dims=cfg["dims"], seed=cfg["seed"], offset=cfg["offset"],
+                        jitter=cfg["jitter"], strength=cfg["t"] if cfg["name"] == "cmjnd" else None, backend=backend)
+
+
+def _cfg(name, s, t, dims, seed, offset, jitter, pixels, samples, dim_idx):
+    return dict(name=name, s=s, t=t, spp=s**t, dims=dims, seed=seed, offset=offset, jitter=jitter,
+                pixels=pixels, samples=samples, dim_idx=dim_idx)
+
+
+@given(cfg=configs())
+@example(cfg=_cfg("bose", 4093, 2, 3 * 4094, U32_MAX, "cmj", 1.0, [U32_MAX], [0, 1, 4093**2 - 1],
+                  [0, 1, 2, 4092, 4093, 4094, 8187, 8188, 3 * 4094 - 1]))
+@example(cfg=_cfg("cmjnd", 2, 24, 49, 0, "j", 1.0, [0, U32_MAX], [0, 1, 2**23, 2**24 - 1], [0, 23, 24, 47, 48]))
+@example(cfg=_cfg("cmjnd", 4096, 2, 5, 1, "mj", 0.5, [7], [0, 4096**2 - 1], [0, 1, 4]))
+@example(cfg=_cfg("cmjnd", 2**24, 1, 3, 5, "cmj", 1.0, [3], [0, 2**24 - 1], [0, 2]))
+@example(cfg=_cfg("cmjnd", 7, 1, 4, 9, "centered", 0.0, [0], [0, 6], [0, 3]))
+@example(cfg=_cfg("bose", 2, 2, 7, 0, "j", 0.0, [zero_hash_pixel(0)], [0, 3], [0, 2, 3, 6]))
+@example(cfg=_cfg("bose", 13, 2, 30, 5, "cmj", 1.0, [1, U32_MAX], list(range(169)), [0, 13, 14, 29]))
+@example(cfg=_cfg("cmjnd", 3, 4, 9, 6, "centered", 0.3, [2], list(range(80, -1, -1)), [0, 3, 4, 8]))
+def test_backend_matches_reference(backend, cfg):
+    smp = make_sampler(cfg, backend)
+    assert smp.backend == backend
+    got = smp.generate(pixels=cfg["pixels"], samples=cfg["samples"], dims=cfg["dim_idx"])
+    want = reference_block(smp, cfg["pixels"], cfg["samples"], cfg["dim_idx"])
+    assert_same_bits(got, want, f"{backend} vs reference")
+    assert np.all(got >= 0) and np.all(got < 1)
+    # Sampler.value (the reference, one value) is the same entry
+    assert smp.value(cfg["pixels"][-1], cfg["samples"][-1], cfg["dim_idx"][-1]) == got[-1, -1, -1]
+
+
+@pytest.mark.opencl
+@given(cfg=configs(), n_pixels=st.integers(1, 40))
+def test_opencl_matches_numpy_in_bulk(cfg, n_pixels):
+    """Larger batches (every sample of many pixels, up to ~10^5 values), kernel vs NumPy."""
+    a = make_sampler(cfg, "numpy")
+    b = make_sampler(cfg, "opencl")
+    n_s = min(cfg["spp"], 2000)
+    samples = range(cfg["spp"] - n_s, cfg["spp"])  # includes the last sample
+    dims = sorted(set(cfg["dim_idx"]) | set(range(min(cfg["dims"], 12))))
+    p0 = cfg["pixels"][0] if cfg["pixels"][0] + n_pixels <= U32_MAX + 1 else U32_MAX + 1 - n_pixels
+    pixels = range(p0, p0 + n_pixels)
+    assert_same_bits(b.generate(pixels, samples, dims), a.generate(pixels, samples, dims), "opencl vs numpy")
+
+
+# ----------------------------------------------------------------------------- explicit edge cases
+
+@pytest.mark.parametrize("offset", ["cmj", "centered", "mj"])
+@pytest.mark.parametrize("name, spp, strength", [("bose", 49, None), ("cmjnd", 27, 3), ("cmjnd", 16, 2),
+                                                 ("bose", 961, None), ("cmjnd", 256, 4)])
+def test_table_path_threshold(backend, name, spp, strength, offset):
+    """Both backends switch to precomputed permutation tables for `cmj` and
+    `centered` once the samples per pixel reach the table size (s, plus M for
+    `cmj`, plus one): sample counts on both sides of that switch give the
+    reference bits, as do chunks that split a pixel's samples."""
+    smp = pyoa.sampler(name, spp=spp, dims=7, strength=strength, seed=21, offset=offset, backend=backend)
+    entries = smp.s + (smp.params.M if offset == "cmj" else 0)
+    for n in sorted({max(1, entries - 1), entries, entries + 1, entries + 2, spp}):
+        n = min(n, spp)
+        samples = list(range(spp - n, spp))
+        got = smp.generate(pixels=[3, U32_MAX], samples=samples)
+        assert_same_bits(got, reference_block(smp, [3, U32_MAX], samples, range(7)), f"{n} samples")
+
+
+def test_table_path_with_chunks(monkeypatch, backend):
+    import pyoa._numpy.backend as nb
+
+    smp = pyoa.sampler("bose", spp=121, dims=14, seed=2, backend=backend)
+    want = reference_block(smp, [7, 8], range(121), [0, 5, 11, 12, 13])
+    if backend == "numpy":
+        monkeypatch.setattr(nb, "CHUNK_VALUES", 14 * 50)
+    else:
+        monkeypatch.setattr(smp._backend, "max_chunk_values", 14 * 50)
+    got = smp.generate(pixels=[7, 8])  # 50-row chunks split both pixels' samples
+    assert_same_bits(got[:, :, [0, 5, 11, 12, 13]], want)
+
+
+SAMPLER_CASES = [
+    pytest.param(dict(name="bose", spp=49, dims=17, strength=None), id="bose-s7"),
+    pytest.param(dict(name="cmjnd", spp=125, dims=10, strength=3), id="cmjnd-s5-t3"),
+]
+
+
+@pytest.mark.parametrize("case", SAMPLER_CASES)
+@pytest.mark.parametrize("seed", [0, 1, U32_MAX - 1, U32_MAX])
+@pytest.mark.parametrize("offset", OFFSETS)
+def test_edge_seeds(backend, case, seed, offset):
+    smp = pyoa.sampler(**case, seed=seed, offset=offset, backend=backend)
+    pixels = [0, 1, U32_MAX, zero_hash_pixel(seed)]
+    samples = [0, 1, smp.spp // 2, smp.spp - 1]
+    got = smp.generate(pixels=pixels, samples=samples)
+    assert_same_bits(got, reference_block(smp, pixels, samples, range(smp.dims)))
+
+
+def test_largest_bose(backend):
+    """s = 4093, spp = 4093^2: only a handful of samples; dims across three blocks."""
+    s = 4093
+    smp = pyoa.sampler("bose", spp=s * s, dims=2 * (s + 1) + 3, seed=11, backend=backend)
+    assert (smp.s, smp.block_dims) == (s, s + 1)
+    samples, dims = [0, 1, s * s - 1], [0, 1, 2, s - 1, s, s + 1, s + 2, 2 * (s + 1), smp.dims - 1]
+    got = smp.generate(pixels=[0, U32_MAX], samples=samples, dims=dims)
+    assert_same_bits(got, reference_block(smp, [0, U32_MAX], samples, dims))
+
+
+def test_largest_cmjnd_spp(backend):
+    """s = 2, t = 24: spp = 2^24 (the maximum), M = 2^23."""
+    smp = pyoa.sampler("cmjnd", spp=2**24, dims=50, seed=3, offset="cmj", backend=backend)
+    assert (smp.s, smp.strength) == (2, 24)
+    samples, dims = [0, 1, 2**23 - 1, 2**23, 2**24 - 2, 2**24 - 1], [0, 1, 22, 23, 24, 47, 48, 49]
+    got = smp.generate(pixels=[5], samples=samples, dims=dims)
+    assert_same_bits(got, reference_block(smp, [5], samples, dims))
+
+
+@pytest.mark.parametrize("s", [2, 7, 4096, 2**24])
+def test_cmjnd_strength_one(backend, s):
+    """t = 1: every dimension is its own block, M = 1 (a plain 1D stratification)."""
+    smp = pyoa.sampler("cmjnd", spp=s, dims=4, strength=1, seed=8, backend=backend)
+    assert (smp.s, smp.strength, smp.block_dims) == (s, 1, 1)
+    samples = sorted({0, 1, s // 2, s - 1})
+    got = smp.generate(pixels=[0, 9], samples=samples)
+    assert_same_bits(got, reference_block(smp, [0, 9], samples, range(4)))
+    if s <= 4096:
+        x = smp.generate(pixels=[2]).astype(np.float64)
+        assert np.array_equal(np.sort(np.floor(x * s), axis=1), np.broadcast_to(np.arange(s)[:, None], (s, 4)).reshape(1, s, 4))
+
+
+def _find_clamped_sample(max_tries: int = 40):
+    """A (pixel, sample) of cmjnd s=2, t=24, dimension 0, whose value rounds to 1.0
+    and must be clamped: stratum 1, sub-stratum M-1 = 2^23-1 and a jitter above 0.75
+    (sub + jitter then rounds to 2^23 in float32). Found by inverting the permutations."""
+    s, t, M = 2, 24, 2**23
+    for pixel in range(max_tries):
+        p = ref.pixel_seed(0, pixel)
+        P1, P2, P3 = ref.dimension_seeds(p, 0)
+        a = next(a for a in range(s) if ref.permute(a, s, P1) == s - 1)
+        perm = nh.permute(np.arange(M, dtype=np.uint32), M, np.uint32(P2))
+        v = int(np.flatnonzero(perm == M - 1)[0])
+        i = a + s * v  # digit 0 is a, the other digits are v
+        if ref.randfloat(i, P3) > 0.75:
+            return pixel, i
+    raise AssertionError("no clamped sample found")
+
+
+def test_value_that_rounds_to_one_is_clamped(backend):
+    """SPEC section 7 through the whole pipeline: the value is 0x3f7fffff in every backend."""
+    pixel, i = _find_clamped_sample()
+    smp = pyoa.sampler("cmjnd", spp=2**24, dims=24, seed=0, jitter=1.0, backend=backend)
+    got = smp.generate(pixels=[pixel], samples=[i], dims=[0])
+    assert int(bits(got)[0, 0, 0]) == 0x3F7FFFFF
+    assert smp.value(pixel, i, 0) == float(got[0, 0, 0])
+
+
+@pytest.mark.parametrize("jitter", [0.0, 1.0, 0.5, 1e-30, 0.999999, float(np.nextafter(np.float32(1), np.float32(0)))])
+def test_jitter_amounts(backend, jitter):
+    smp = pyoa.sampler("bose", spp=25, dims=7, seed=4, jitter=jitter, offset="mj", backend=backend)
+    got = smp.generate(pixels=[0, 3])
+    assert_same_bits(got, reference_block(smp, [0, 3], range(25), range(7)))
+
+
+@pytest.mark.parametrize("name, spp, strength", [("bose", 121, None), ("cmjnd", 64, 3), ("cmjnd", 10, 1)])
+def test_value_equals_generate(backend, name, spp, strength):
+    smp = pyoa.sampler(name, spp=spp, dims=9, strength=strength, seed=77, backend=backend, offset="j")
+    x = smp.generate(pixels=[0, 12345, U32_MAX])
+    for a, pix in enumerate([0, 12345, U32_MAX]):
+        for i in (0, 1, spp - 1):
+            for j in (0, 3, 8):
+                v = smp.value(pix, i, j)
+                assert isinstance(v, float)
+                assert np.float32(v).view(np.uint32) == x[a, i, j].view(np.uint32)
+
+
+def test_reference_is_not_backend_dependent_by_accident(backend):
+    """Guards the whole suite: different seeds, offsets and jitters give different bits,
+    so the equality tests above compare something."""
+    base = dict(spp=49, dims=9, backend=backend)
+    x = pyoa.sampler("bose", seed=1, **base).generate(pixels=[0])
+    assert not np.array_equal(x, pyoa.sampler("bose", seed=2, **base).generate(pixels=[0]))
+    assert not np.array_equal(x, pyoa.sampler("bose", seed=1, offset="mj", **base).generate(pixels=[0]))
+    assert not np.array_equal(x, pyoa.sampler("bose", seed=1, jitter=0.5, **base).generate(pixels=[0]))
+    assert not np.array_equal(x, pyoa.sampler("bose", seed=1, **base).generate(pixels=[1]))

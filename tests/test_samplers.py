@@ -1,0 +1,420 @@
+"""The user-facing API (pyoa.samplers): shapes, defaults, attributes, order and
+chunk independence, memory cap, thread safety, input validation."""
+
+from __future__ import annotations
+
+import math
+import re
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+import pyoa
+import pyoa._numpy.backend as numpy_backend
+from tests.helpers import U32_MAX, assert_same_bits, reference_block
+
+
+@pytest.fixture(params=[pytest.param(("bose", 49, 11, None), id="bose"),
+                        pytest.param(("cmjnd", 64, 7, 3), id="cmjnd")])
+def smp(request, backend):
+    name, spp, dims, strength = request.param
+    return pyoa.sampler(name, spp=spp, dims=dims, strength=strength, seed=123, backend=backend)
+
+
+# ----------------------------------------------------------------------------- shape, dtype, defaults
+
+def test_shape_dtype_contiguity(smp):
+    for kw, shape in [
+        ({}, (1, smp.spp, smp.dims)),
+        ({"pixels": range(3)}, (3, smp.spp, smp.dims)),
+        ({"pixels": [7], "samples": [5, 2], "dims": [0]}, (1, 2, 1)),
+        ({"samples": range(smp.spp - 1, -1, -1), "dims": [smp.dims - 1, 0]}, (1, smp.spp, 2)),
+        ({"pixels": []}, (0, smp.spp, smp.dims)),
+        ({"dims": []}, (1, smp.spp, 0)),
+        ({"samples": range(0)}, (1, 0, smp.dims)),
+    ]:
+        x = smp.generate(**kw)
+        assert x.shape == shape, kw
+        assert x.dtype == np.float32
+        assert x.flags["C_CONTIGUOUS"]
+        assert np.all((x >= 0) & (x < 1))
+
+
+def test_defaults_are_pixel_0_all_samples_all_dims(smp):
+    x = smp.generate()
+    y = smp.generate(pixels=[0], samples=range(smp.spp), dims=range(smp.dims))
+    assert_same_bits(x, y)
+    assert_same_bits(x[:, :5, :], reference_block(smp, [0], range(5), range(smp.dims)))
+
+
+def test_sampler_defaults():
+    s = pyoa.sampler("bose", spp=9, dims=2, backend="numpy")
+    assert (s.seed, s.offset, s.jitter) == (0, "cmj", 1.0)
+    assert s.max_bytes > 0
+
+
+def test_attributes_and_repr(backend):
+    s = pyoa.sampler("bose", spp=121, dims=30, seed=42, offset="mj", jitter=0.1, backend=backend)
+    assert (s.name, s.spp, s.dims, s.s, s.strength, s.block_dims) == ("bose", 121, 30, 11, 2, 12)
+    assert (s.offset, s.seed, s.backend) == ("mj", 42, backend)
+    assert s.jitter == float(np.float32(0.1)) and s.jitter != 0.1  # stored as float32
+    assert isinstance(s.device, str) and s.device
+    r = repr(s)
+    for part in ("'bose'", "spp=121", "dims=30", "seed=42", "offset='mj'", "jitter=0.1", "s=11", "strength=2",
+                 "block_dims=12", f"backend='{backend}'"):
+        assert part in r, (part, r)
+    c = pyoa.sampler("CMJND", spp=625, dims=4, backend=backend)
+    assert (c.name, c.s, c.strength, c.block_dims) == ("cmjnd", 5, 4, 4)
+
+
+@pytest.mark.parametrize("spp, dims, strength, want", [
+    (64, 8, None, (2, 6)),   # largest t <= dims with spp = s^t
+    (64, 3, None, (4, 3)),
+    (64, 2, None, (8, 2)),
+    (64, 1, None, (64, 1)),  # dims == 1: t = 1
+    (64, 8, 2, (8, 2)),
+    (64, 2, 3, (4, 3)),      # explicit strength may exceed dims
+    (27, 5, None, (3, 3)),
+    (2**24, 24, None, (2, 24)),
+])
+def test_cmjnd_strength_choice(spp, dims, strength, want):
+    s = pyoa.sampler("cmjnd", spp=spp, dims=dims, strength=strength, backend="numpy")
+    assert (s.s, s.strength) == want
+    assert s.block_dims == s.strength
+
+
+def test_samplers_listing():
+    names = pyoa.samplers()
+    assert set(names) == {"bose", "cmjnd"}
+    assert all(isinstance(v, str) and v for v in names.values())
+
+
+def test_valid_spp():
+    bose = pyoa.valid_spp("bose")
+    assert bose[0] == pyoa.SppChoice(4, 2, 2, 3)
+    assert bose[-1] == pyoa.SppChoice(4093**2, 4093, 2, 4094)
+    assert all(math.isqrt(c.spp) ** 2 == c.spp for c in bose)
+    assert [c.spp for c in bose] == sorted(c.spp for c in bose)
+    assert 120 not in [c.spp for c in bose] and 121 in [c.spp for c in bose]
+    assert [c.label() for c in pyoa.valid_spp("bose", near=120)] == ["121 (s=11)", "169 (s=13)"]
+    assert [c.spp for c in pyoa.valid_spp("bose", near=121)] == [121, 169] or \
+        [c.spp for c in pyoa.valid_spp("bose", near=121)] == [49, 121]
+    cubes = pyoa.valid_spp("cmjnd", strength=3)
+    assert [c.spp for c in cubes] == [s**3 for s in range(2, 257)]
+    assert cubes[1].label() == "27 (s=3, t=3)"
+    two = pyoa.valid_spp("cmjnd", dims=2)
+    assert {c.strength for c in two} == {2} and two[-1].spp == 4096**2
+    with pytest.raises(ValueError, match="unknown sampler 'sobol'"):
+        pyoa.valid_spp("sobol")
+
+
+# ----------------------------------------------------------------------------- order and chunk independence
+
+def test_order_independence(smp):
+    pixels = [0, 5, 17, U32_MAX]
+    whole = smp.generate(pixels=pixels)
+    # split pixels
+    assert_same_bits(np.concatenate([smp.generate(pixels=[p]) for p in pixels]), whole, "split pixels")
+    # split samples
+    cuts = [0, 1, smp.spp // 3, smp.spp - 1, smp.spp]
+    parts = [smp.generate(pixels=pixels, samples=range(a, b)) for a, b in zip(cuts, cuts[1:])]
+    assert_same_bits(np.concatenate(parts, axis=1), whole, "split samples")
+    # permuted dims
+    perm = np.random.default_rng(1).permutation(smp.dims)
+    assert_same_bits(smp.generate(pixels=pixels, dims=perm.tolist()), whole[:, :, perm], "permuted dims")
+    # reversed ranges
+    rev = smp.generate(pixels=pixels[::-1], samples=range(smp.spp - 1, -1, -1), dims=range(smp.dims - 1, -1, -1))
+    assert_same_bits(rev, whole[::-1, ::-1, ::-1], "reversed")
+    # repeated indices and numpy index arrays of other integer dtypes
+    rep = smp.generate(pixels=np.array([5, 5], dtype=np.int64), samples=np.array([3, 3, 0], dtype=np.uint16),
+                       dims=np.array([1, 1], dtype=np.int8))
+    assert_same_bits(rep, whole[[1, 1]][:, [3, 3, 0]][:, :, [1, 1]], "repeated")
+    # one value at a time
+    for a, b, c in [(0, 0, 0), (3, smp.spp - 1, smp.dims - 1), (1, 7, 3)]:
+        one = smp.generate(pixels=[pixels[a]], samples=[b], dims=[c])
+        assert_same_bits(one[0, 0, 0], whole[a, b, c], "single value")
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 64, 1000])
+def test_chunking_does_not_change_results(monkeypatch, smp, chunk):
+    pixels = range(U32_MAX - 4, U32_MAX + 1)
+    want = smp.generate(pixels=pixels)
+    if smp.backend == "numpy":
+        monkeypatch.setattr(numpy_backend, "CHUNK_VALUES", chunk)
+    else:
+        monkeypatch.setattr(smp._backend, "max_chunk_values", chunk)
+    n_rows = 5 * smp.spp
+    assert smp._backend.rows_per_chunk(smp.dims) < n_rows  # really chunked
+    calls = []
+    fill = smp._backend.fill
+    monkeypatch.setattr(smp._backend, "fill", lambda *a: (calls.append(a[1:3]), fill(*a))[1])
+    got = smp.generate(pixels=pixels)
+    assert_same_bits(got, want, f"chunk={chunk}")
+    assert len(calls) > 1
+    # chunks tile the rows exactly once (they may run in any order, on several threads)
+    calls.sort()
+    assert calls[0][0] == 0 and calls[-1][1] == n_rows
+    assert all(a[1] == b[0] for a, b in zip(calls, calls[1:]))
+    monkeypatch.setattr(smp._backend, "fill", fill)
+    assert_same_bits(smp.generate(pixels=pixels, samples=[smp.spp - 1, 0], dims=[2, 0, 1]),
+                     want[:, [smp.spp - 1, 0]][:, :, [2, 0, 1]])
+
+
+def test_progress_bar_gives_same_result(monkeypatch, smp, capsys):
+    want = smp.generate(pixels=range(3))
+    if smp.backend == "numpy":
+        monkeypatch.setattr(numpy_backend, "CHUNK_VALUES", 50)
+    else:
+        monkeypatch.setattr(smp._backend, "max_chunk_values", 50)
+    assert_same_bits(smp.generate(pixels=range(3), progress=True), want)
+
+
+# ----------------------------------------------------------------------------- memory cap
+
+def test_max_bytes(backend):
+    s = pyoa.sampler("bose", spp=121, dims=8, max_bytes=1000, backend=backend)
+    with pytest.raises(ValueError) as exc:
+        s.generate()
+    msg = str(exc.value)
+    assert "1 x 121 x 8" in msg
+    assert "3.8 KiB" in msg  # 121 * 8 * 4 = 3872 bytes
+    assert "1000 B" in msg and "max_bytes" in msg
+    # the cap is on the request, not the sampler: a smaller request fits
+    assert s.generate(samples=range(31)).shape == (1, 31, 8)  # 992 bytes
+    exact = pyoa.sampler("bose", spp=121, dims=8, max_bytes=121 * 8 * 4, backend=backend)
+    assert exact.generate().shape == (1, 121, 8)
+
+
+def test_max_bytes_large_request_message():
+    s = pyoa.sampler("bose", spp=4093**2, dims=64, max_bytes="1G", backend="numpy")
+    assert s.max_bytes == 1 << 30
+    with pytest.raises(ValueError, match=re.escape("1000 x 16752649 x 64")) as exc:
+        s.generate(pixels=range(1000))
+    assert "TiB" in str(exc.value) and "1.0 GiB" in str(exc.value)
+
+
+def test_max_bytes_from_environment(monkeypatch):
+    monkeypatch.setenv("PYOA_MAX_BYTES", "2k")
+    s = pyoa.sampler("bose", spp=121, dims=8, backend="numpy")
+    assert s.max_bytes == 2048
+    with pytest.raises(ValueError, match="PYOA_MAX_BYTES"):
+        s.generate()
+
+
+@pytest.mark.parametrize("text, want", [("4G", 4 << 30), ("512MiB", 512 << 20), ("1e9", 10**9), ("2k", 2048),
+                                        ("100", 100)])
+def test_parse_bytes(text, want):
+    from pyoa.samplers import parse_bytes
+
+    assert parse_bytes(text) == want
+
+
+def test_parse_bytes_fraction_of_ram():
+    from pyoa.samplers import _physical_memory, parse_bytes
+
+    assert parse_bytes("0.25") == int(0.25 * _physical_memory())
+    with pytest.raises(ValueError, match="memory size"):
+        parse_bytes("lots")
+
+
+# ----------------------------------------------------------------------------- threads
+
+def test_thread_safety(smp):
+    pixels = range(16)
+    want = smp.generate(pixels=pixels)
+    barrier = threading.Barrier(8)
+
+    def work(k):
+        barrier.wait()
+        return [smp.generate(pixels=pixels) for _ in range(3)]
+
+    with ThreadPoolExecutor(8) as pool:
+        results = [x for xs in pool.map(work, range(8)) for x in xs]
+    for x in results:
+        assert_same_bits(x, want, "threaded")
+
+
+def test_thread_safety_mixed_requests(backend):
+    """Different requests interleaved on one sampler (and one shared backend)."""
+    smp = pyoa.sampler("cmjnd", spp=81, dims=9, strength=4, seed=5, backend=backend)
+    reqs = [dict(pixels=[k], samples=range(k % 81, 81), dims=range(k % 9, 9)) for k in range(24)]
+    want = [smp.generate(**r) for r in reqs]
+    with ThreadPoolExecutor(6) as pool:
+        got = list(pool.map(lambda r: smp.generate(**r), reqs * 3))
+    for g, w in zip(got, want * 3):
+        assert_same_bits(g, w)
+
+
+# ----------------------------------------------------------------------------- bad inputs
+
+@pytest.mark.parametrize("kwargs, exc, words", [
+    (dict(name="bose", spp=120), ValueError, ["120", "121 (s=11)", "169 (s=13)"]),
+    (dict(name="bose", spp=100), ValueError, ["100", "prime", "49 (s=7)", "121 (s=11)"]),
+    (dict(name="bose", spp=4096**2), ValueError, ["prime", "4093"]),
+    (dict(name="bose", spp=4099**2), ValueError, ["spp", "16777216"]),
+    (dict(name="bose", spp=0), ValueError, ["spp"]),
+    (dict(name="bose", spp=-4), ValueError, ["spp"]),
+    (dict(name="bose", spp=121.0), TypeError, ["spp", "integer"]),
+    (dict(name="bose", spp="121"), TypeError, ["spp"]),
+    (dict(name="bose", spp=True), TypeError, ["spp"]),
+    (dict(name="bose", spp=121, strength=3), ValueError, ["strength", "cmjnd"]),
+    (dict(name="bose", spp=121, strength=1), ValueError, ["strength 2"]),
+    (dict(name="cmjnd", spp=1000, dims=2), ValueError, ["1000", "961 (s=31)", "1024 (s=32)"]),
+    (dict(name="cmjnd", spp=100, dims=8, strength=3), ValueError, ["100", "s^3", "64 (s=4, t=3)", "125 (s=5, t=3)"]),
+    (dict(name="cmjnd", spp=2**25, dims=25), ValueError, ["spp"]),
+    (dict(name="cmjnd", spp=64, strength=0), ValueError, ["strength"]),
+    (dict(name="cmjnd", spp=64, strength=25), ValueError, ["strength", "24"]),
+    (dict(name="cmjnd", spp=64, strength=3.0), TypeError, ["strength"]),
+    (dict(name="bose", spp=121, dims=0), ValueError, ["dims"]),
+    (dict(name="bose", spp=121, dims=-2), ValueError, ["dims"]),
+    (dict(name="bose", spp=121, dims=2**20 + 1), ValueError, ["dims", "1048576"]),
+    (dict(name="bose", spp=121, dims=2.0), TypeError, ["dims"]),
+    (dict(name="bose", spp=121, dims="8"), TypeError, ["dims"]),
+    (dict(name="bose", spp=121, dims=False), TypeError, ["dims"]),
+    (dict(name="bose", spp=121, seed=-1), ValueError, ["seed"]),
+    (dict(name="bose", spp=121, seed=2**32), ValueError, ["seed", "4294967295"]),
+    (dict(name="bose", spp=121, seed=1.5), TypeError, ["seed"]),
+    (dict(name="bose", spp=121, seed=True), TypeError, ["seed"]),
+    (dict(name="bose", spp=121, seed="7"), TypeError, ["seed"]),
+    (dict(name="bose", spp=121, offset="foo"), ValueError, ["offset", "'foo'", "cmj", "centered"]),
+    (dict(name="bose", spp=121, offset=None), ValueError, ["offset"]),
+    (dict(name="bose", spp=121, jitter=-0.1), ValueError, ["jitter", "[0, 1]"]),
+    (dict(name="bose", spp=121, jitter=1.0000001), ValueError, ["jitter"]),
+    (dict(name="bose", spp=121, jitter=float("nan")), ValueError, ["jitter", "nan"]),
+    (dict(name="bose", spp=121, jitter=float("inf")), ValueError, ["jitter"]),
+    (dict(name="bose", spp=121, jitter="0.5"), TypeError, ["jitter"]),
+    (dict(name="bose", spp=121, jitter=None), TypeError, ["jitter"]),
+    (dict(name="bose", spp=121, jitter=True), TypeError, ["jitter"]),
+    (dict(name="sobol", spp=121), ValueError, ["sobol", "bose", "cmjnd"]),
+    (dict(name=3, spp=121), TypeError, ["name"]),
+    (dict(name="bose", spp=121, backend="cuda"), ValueError, ["cuda", "opencl", "numpy"]),
+    (dict(name="bose", spp=121, backend=1), TypeError, ["backend"]),
+    (dict(name="bose", spp=121, max_bytes=0), ValueError, ["max_bytes"]),
+    (dict(name="bose", spp=121, max_bytes="lots"), ValueError, ["lots"]),
+])
+def test_bad_constructor_arguments(kwargs, exc, words):
+    kwargs = {"dims": 4, **kwargs}
+    name = kwargs.pop("name")
+    with pytest.raises(exc) as info:
+        pyoa.sampler(name, **kwargs)
+    msg = str(info.value)
+    for w in words:
+        assert w in msg, f"{w!r} not in {msg!r}"
+
+
+@pytest.mark.parametrize("kw", [dict(seed=np.uint32(U32_MAX)), dict(seed=np.int64(5)), dict(spp=np.int16(121)),
+                                dict(jitter=np.float32(0.25)), dict(jitter=0), dict(jitter=1),
+                                dict(strength=np.int8(2)), dict(max_bytes="1M"), dict(offset="centered")])
+def test_good_unusual_constructor_arguments(kw):
+    s = pyoa.sampler("bose", **{"spp": 121, "dims": 4, "backend": "numpy", **kw})
+    assert s.generate(samples=[0]).shape == (1, 1, 4)
+    assert type(s.seed) is int and type(s.spp) is int
+
+
+BAD_INDICES = [
+    (5, TypeError, ["range or a sequence"]),
+    (np.int64(5), TypeError, ["range or a sequence"]),
+    ("0", TypeError, []),
+    (b"0", TypeError, []),
+    ((i for i in range(2)), TypeError, []),
+    ([1.0], TypeError, ["integers", "float"]),
+    (np.array([0.0, 1.0]), TypeError, ["float"]),
+    ([True, False], TypeError, ["bool"]),
+    ([1, "a"], TypeError, []),
+    (np.array([[0, 1]]), ValueError, ["one-dimensional", "(1, 2)"]),
+    ([[0], [1]], ValueError, ["one-dimensional"]),
+    (np.array(3), (ValueError, TypeError), []),
+    ([-1], ValueError, ["-1"]),
+    (np.array([0, -5]), ValueError, ["-5"]),
+    (range(-1, 2), ValueError, []),
+]
+
+
+def _ids(cases):
+    return [re.sub(r"\s+", "", repr(c[0]))[:40] for c in cases]
+
+
+PIXEL_CASES = BAD_INDICES + [
+    ([2**32], ValueError, ["4294967296"]),
+    ([2**64], ValueError, []),
+    (range(U32_MAX, U32_MAX + 2), ValueError, ["4294967296"]),
+    (range(2**64), ValueError, ["pixels"]),
+]
+
+
+@pytest.mark.parametrize("value, exc, words", PIXEL_CASES, ids=_ids(PIXEL_CASES))
+def test_bad_pixels(value, exc, words):
+    s = pyoa.sampler("bose", spp=9, dims=2, backend="numpy")
+    with pytest.raises(exc) as info:
+        s.generate(pixels=value)
+    assert "pixels" in str(info.value)
+    for w in words:
+        assert w in str(info.value)
+
+
+SAMPLE_CASES = BAD_INDICES + [
+    ([9], ValueError, ["[0, 9)", "9"]),
+    (range(0, 10), ValueError, ["[0, 9)"]),
+    (np.arange(10), ValueError, ["[0, 9)"]),
+]
+
+
+@pytest.mark.parametrize("value, exc, words", SAMPLE_CASES, ids=_ids(SAMPLE_CASES))
+def test_bad_samples(value, exc, words):
+    s = pyoa.sampler("bose", spp=9, dims=2, backend="numpy")
+    with pytest.raises(exc) as info:
+        s.generate(samples=value)
+    assert "samples" in str(info.value)
+    for w in words:
+        assert w in str(info.value)
+
+
+DIM_CASES = BAD_INDICES + [
+    ([2], ValueError, ["[0, 2)"]),
+    (range(3), ValueError, ["[0, 2)"]),
+]
+
+
+@pytest.mark.parametrize("value, exc, words", DIM_CASES, ids=_ids(DIM_CASES))
+def test_bad_dims(value, exc, words):
+    s = pyoa.sampler("bose", spp=9, dims=2, backend="numpy")
+    with pytest.raises(exc) as info:
+        s.generate(dims=value)
+    assert "dims" in str(info.value)
+    for w in words:
+        assert w in str(info.value)
+
+
+def test_good_index_forms():
+    s = pyoa.sampler("bose", spp=9, dims=3, seed=2, backend="numpy")
+    want = s.generate(pixels=[1, U32_MAX], samples=[0, 8], dims=[2])
+    for pixels in ([1, U32_MAX], (1, U32_MAX), np.array([1, U32_MAX], dtype=np.uint32),
+                   np.array([1, U32_MAX], dtype=np.uint64), [np.int64(1), np.uint32(U32_MAX)],
+                   np.array([1, U32_MAX], dtype=object)):
+        assert_same_bits(s.generate(pixels=pixels, samples=range(0, 9, 8), dims=(2,)), want, repr(pixels))
+
+
+@pytest.mark.parametrize("pixel, i, j, exc", [
+    (-1, 0, 0, ValueError), (2**32, 0, 0, ValueError), (0, 9, 0, ValueError), (0, -1, 0, ValueError),
+    (0, 0, 3, ValueError), (0.0, 0, 0, TypeError), (0, 1.0, 0, TypeError), (0, 0, True, TypeError),
+])
+def test_bad_value_arguments(pixel, i, j, exc):
+    s = pyoa.sampler("bose", spp=9, dims=3, backend="numpy")
+    with pytest.raises(exc):
+        s.value(pixel, i, j)
+
+
+def test_invalid_spp_error_is_fast():
+    """cmjnd with dims=1 (t = 1: every spp >= 2 is valid) and spp=1: the error names
+    the nearest counts; building it must not enumerate ~2^24 candidates."""
+    import subprocess
+    import sys
+
+    code = "import pyoa\ntry:\n    pyoa.sampler('cmjnd', spp=1, dims=1)\nexcept ValueError as e:\n    print(e)\n"
+    try:
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=5)
+    except subprocess.TimeoutExpired:
+        pytest.fail("pyoa.sampler('cmjnd', spp=1, dims=1) took more than 5 s to raise its ValueError")
+    assert "2 (s=2, t=1)" in res.stdout, res.stdout + res.stderr
