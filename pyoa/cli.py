@@ -42,6 +42,14 @@ def save_points(x: np.ndarray, path: str, pixels: range) -> None:
                 np.savetxt(fh, np.column_stack([pix, smp, x.reshape(n_p * n_s, n_d).astype(np.float64)]), fmt=fmt)
 
 
+def _rate(per_s: float) -> str:
+    """``1234567.0`` -> ``"1.23 M"``."""
+    for unit, scale in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
+        if per_s >= scale:
+            return f"{per_s / scale:.3g} {unit}"
+    return f"{per_s:.3g}"
+
+
 def cmd_points(args) -> int:
     smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, offset=args.offset,
                   jitter=args.jitter, strength=args.strength, backend=args.backend, device=args.device)
@@ -53,7 +61,7 @@ def cmd_points(args) -> int:
     if not args.quiet:
         print(smp)
         print(f"{x.size:,} values ({x.shape[0]} pixels x {x.shape[1]} samples x {x.shape[2]} dims) "
-              f"in {dt:.3f} s ({x.size / max(dt, 1e-9) / 1e6:.1f} M values/s) -> {args.out}")
+              f"in {dt:.3f} s ({_rate(x.size / max(dt, 1e-9))} values/s) -> {args.out}")
     return 0
 
 
