@@ -30,7 +30,9 @@ __kernel void generate(__global float *out,
                        const uint s,
                        const uint t,
                        const uint offset,
-                       const float J)
+                       const float J,
+                       __global const ushort *gf,
+                       const uint gf_tabled)
 {
     uint gid = (uint)get_global_id(0);
     if (gid >= n_values) return;
@@ -38,8 +40,11 @@ __kernel void generate(__global float *out,
     uint dim = dims[gid % n_dims];
     uint i = samples[row % n_samples];
     uint p = pixel_seed(seed, pixels[row / n_samples]);
-    out[gid] = (construction == CONSTRUCTION_BOSE) ? bose(i, dim, s, p, offset, J)
-                                                   : cmjnd(i, dim, s, t, p, offset, J);
+    float x;
+    if (construction == CONSTRUCTION_BOSE)      x = bose(i, dim, s, p, offset, J, gf, gf_tabled);
+    else if (construction == CONSTRUCTION_BUSH) x = bush(i, dim, s, t, p, offset, J, gf, gf_tabled);
+    else                                        x = cmjnd(i, dim, s, t, p, offset, J);
+    out[gid] = x;
 }
 
 /* One work-item per table entry of the uploaded pixels. */
@@ -64,7 +69,7 @@ __kernel void tables(__global uint *tab,
 }
 
 /* The table-driven value kernels; CELL computes aij and u (the sub-stratum
- * index) from i, the column col and the per-column power sj. */
+ * index) from i and the column col (CMJND reads s^col from `powers`). */
 #define GENERATE_TABLED(NAME, CELL)                                                     \
 __kernel void NAME(__global float *out,                                                 \
                    __global const uint *tab,                                            \
@@ -79,8 +84,11 @@ __kernel void NAME(__global float *out,                                         
                    const uint dmax,                                                     \
                    const uint s,                                                        \
                    const uint M,                                                        \
+                   const uint t,                                                        \
                    const uint offset,                                                   \
-                   const float J)                                                       \
+                   const float J,                                                       \
+                   __global const ushort *gf,                                           \
+                   const uint gf_tabled)                                                \
 {                                                                                       \
     uint gid = (uint)get_global_id(0);                                                  \
     if (gid >= n_values) return;                                                        \
@@ -97,5 +105,6 @@ __kernel void NAME(__global float *out,                                         
     out[gid] = oa_value(i, tab[base + aij], sub, tab[base + E - 1u], M, s, J);          \
 }
 
-GENERATE_TABLED(generate_tabled_bose, bose_cell(i, col, s, &aij, &u))
+GENERATE_TABLED(generate_tabled_bose, bose_cell(i, col, s, gf, gf_tabled, &aij, &u))
+GENERATE_TABLED(generate_tabled_bush, bush_cell(i, col, s, t, M, gf, gf_tabled, &aij, &u))
 GENERATE_TABLED(generate_tabled_cmjnd, cmjnd_cell(i, s, powers[col], &aij, &u))

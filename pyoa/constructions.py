@@ -24,6 +24,8 @@ import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from . import gf
+
 #: Offset styles of SPEC section 4, in the order of their kernel codes.
 OFFSETS = ("centered", "j", "mj", "cmj")
 OFFSET_CODES = {name: code for code, name in enumerate(OFFSETS)}
@@ -121,18 +123,49 @@ class Construction:
     """Base class: one entry of the catalogue.
 
     Subclasses define :meth:`choices` (every valid sample count) and
-    :meth:`resolve` (the parameters for a requested count).
+    :meth:`resolve` (the parameters for a requested count). ``function`` names
+    the sampler function, the same in :mod:`pyoa.reference` and
+    :mod:`pyoa._numpy.oa`, called as ``function(i, j, *shape_args(params), p,
+    offset, jitter)``.
     """
 
     name: str
     code: int
     description: str
+    #: whether the integer array is computed in GF(s) (the backends then need
+    #: pyoa.gf's tables for prime-power s)
+    uses_field = False
+
+    @property
+    def function(self) -> str:
+        return self.name.replace("-", "_")
+
+    def shape_args(self, params: Params) -> tuple[int, ...]:
+        return (params.s, params.strength)
 
     def choices(self, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
         raise NotImplementedError
 
-    def resolve(self, spp: int, dims: int, strength: int | None) -> Params:
+    def solve(self, spp: int, dims: int | None, strength: int | None) -> Params | None:
+        """The parameters for ``spp`` samples, or None if it is not a valid count.
+
+        Raises ValueError only for an invalid ``strength`` argument."""
         raise NotImplementedError
+
+    def invalid(self, spp: int, dims: int | None, strength: int | None) -> str:
+        """Why ``spp`` is not a valid count (the start of the error message)."""
+        raise NotImplementedError
+
+    def resolve(self, spp: int, dims: int | None, strength: int | None) -> Params:
+        """Like :meth:`solve`, but an invalid count raises a ValueError naming the
+        nearest valid counts of this construction and the others that accept it."""
+        prm = self.solve(spp, dims, strength)
+        if prm is None:
+            raise ValueError(
+                f"{self.name}: {self.invalid(spp, dims, strength)}; nearest: "
+                f"{_labels(self.nearest(spp, dims, strength))}{_elsewhere(self, spp, dims)}"
+            )
+        return prm
 
     def nearest(self, spp: int, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
         """The two valid counts closest to ``spp``."""
@@ -140,30 +173,86 @@ class Construction:
 
 
 class Bose(Construction):
-    """Bose (1938): strength 2, s prime, N = s**2, s+1 dimensions per block."""
+    """Bose (1938): strength 2, s a prime power, N = s**2, s+1 dimensions per block."""
 
     name = "bose"
     code = 0
-    description = "Bose OA, strength 2: N = s^2 with s prime, s+1 dimensions per block"
+    uses_field = True
+    description = "Bose OA, strength 2: N = s^2 with s a prime power, s+1 dimensions per block"
     #: the largest prime with s**2 <= MAX_SPP
     max_s = max(p for p in range(math.isqrt(MAX_SPP), 1, -1) if is_prime(p))
+
+    def shape_args(self, params):
+        return (params.s,)
 
     def choices(self, dims=None, strength=None):
         if strength not in (None, 2):
             return []
-        return [SppChoice(s * s, s, 2, s + 1) for s in range(2, self.max_s + 1) if is_prime(s)]
+        return [SppChoice(s * s, s, 2, s + 1) for s in range(2, self.max_s + 1) if gf.is_supported(s)]
 
-    def resolve(self, spp, dims, strength):
+    def solve(self, spp, dims, strength):
         if strength not in (None, 2):
             raise ValueError(
                 f"bose has strength 2 only (got strength={strength}); "
-                "use 'cmjnd' for strength t >= 3 (N = s^t)"
+                "use 'bush' or 'cmjnd' for strength t >= 3 (N = s^t)"
             )
         s = math.isqrt(spp)
-        if s * s != spp or not is_prime(s) or s > self.max_s:
-            near = _labels(self.nearest(spp))
-            raise ValueError(f"bose: {spp} is not s^2 with s prime (s <= {self.max_s}); nearest: {near}")
+        if s * s != spp or not gf.is_supported(s) or s > self.max_s:
+            return None
         return Params(s=s, strength=2, block_dims=s + 1, M=s)
+
+    def invalid(self, spp, dims, strength):
+        return f"{spp} is not s^2 with s a prime (<= {self.max_s}) or a prime power (<= {gf.MAX_TABLE_Q})"
+
+
+class Bush(Construction):
+    """Bush (1952): strength t, s a prime power, t <= s, N = s**t, s+1 dimensions per block."""
+
+    name = "bush"
+    code = 2
+    uses_field = True
+    description = "Bush OA, strength t: N = s^t with s a prime power and t <= s, s+1 dimensions per block"
+
+    @staticmethod
+    def _strengths(dims, strength):
+        if strength is not None:
+            return [strength]
+        return list(range(2, max(2, min(dims or 24, 24)) + 1))
+
+    def choices(self, dims=None, strength=None):
+        out = []
+        for t in self._strengths(dims, strength):
+            s = max(2, t)
+            while s**t <= MAX_SPP:
+                if gf.is_supported(s):
+                    out.append(SppChoice(s**t, s, t, s + 1))
+                s += 1
+        return sorted(out)
+
+    def nearest(self, spp, dims=None, strength=None):
+        cands = []
+        for t in self._strengths(dims, strength):
+            root = int(round(max(spp, 1) ** (1.0 / t)))
+            s_max = integer_root_floor(MAX_SPP, t)
+            near = [s for s in range(max(2, t, root - 8), min(s_max, root + 8) + 1) if gf.is_supported(s)]
+            below = [s for s in range(min(s_max, root), max(1, t - 1), -1) if gf.is_supported(s)][:1]
+            cands += [SppChoice(s**t, s, t, s + 1) for s in {*near, *below}]
+        return nearest(cands, spp)
+
+    def solve(self, spp, dims, strength):
+        if strength is not None and not 2 <= strength <= 24:
+            raise ValueError(f"bush strength must be an integer in [2, 24], got {strength}")
+        # The largest t <= dims (t >= 2): the most dimensions stratified jointly.
+        for t in sorted(self._strengths(dims, strength), reverse=True):
+            s = integer_root(spp, t)
+            if s is not None and s >= t and gf.is_supported(s):
+                return Params(s=s, strength=t, block_dims=s + 1, M=spp // s)
+        return None
+
+    def invalid(self, spp, dims, strength):
+        ts = self._strengths(dims, strength)
+        what = f"s^{strength}" if strength is not None else f"s^t for any strength 2 <= t <= {ts[-1]}"
+        return (f"{spp} is not {what} with s >= t a prime, or a prime power <= {gf.MAX_TABLE_Q}")
 
 
 class CMJND(Construction):
@@ -204,30 +293,38 @@ class CMJND(Construction):
                 s += 1
         return sorted(out)
 
-    def resolve(self, spp, dims, strength):
-        if strength is not None:
-            if not 1 <= strength <= self.max_strength:
-                raise ValueError(f"cmjnd strength must be an integer in [1, {self.max_strength}], got {strength}")
-            s = integer_root(spp, strength)
-            if s is None or s < 2:
-                near = _labels(self.nearest(spp, strength=strength))
-                raise ValueError(f"cmjnd: {spp} is not s^{strength} with s >= 2; nearest: {near}")
-            return Params(s=s, strength=strength, block_dims=strength, M=spp // s)
+    def solve(self, spp, dims, strength):
+        if strength is not None and not 1 <= strength <= self.max_strength:
+            raise ValueError(f"cmjnd strength must be an integer in [1, {self.max_strength}], got {strength}")
         # No strength given: the largest t <= dims (t >= 2 unless dims == 1)
         # such that spp = s^t: the most dimensions stratified jointly.
-        for t in sorted(self._strengths(dims, None), reverse=True):
+        for t in sorted(self._strengths(dims, strength), reverse=True):
             s = integer_root(spp, t)
             if s is not None and s >= 2:
                 return Params(s=s, strength=t, block_dims=t, M=spp // s)
+        return None
+
+    def invalid(self, spp, dims, strength):
+        if strength is not None:
+            return f"{spp} is not s^{strength} with s >= 2"
         ts = self._strengths(dims, None)
-        near = _labels(self.nearest(spp, dims=dims))
-        raise ValueError(
-            f"cmjnd: {spp} is not s^t with s >= 2 for any strength {ts[0]} <= t <= {ts[-1]} "
-            f"(dims={dims}); nearest: {near}"
-        )
+        return f"{spp} is not s^t with s >= 2 for any strength {ts[0]} <= t <= {ts[-1]} (dims={dims})"
 
 
-CONSTRUCTIONS: dict[str, Construction] = {c.name: c for c in (Bose(), CMJND())}
+CONSTRUCTIONS: dict[str, Construction] = {c.name: c for c in (Bose(), Bush(), CMJND())}
+
+
+def _elsewhere(this: Construction, spp: int, dims: int | None) -> str:
+    """``"; 64 is valid for bush (s=4, t=3), cmjnd (s=8)"``, or ``""``."""
+    found = []
+    for c in CONSTRUCTIONS.values():
+        if c is this:
+            continue
+        prm = c.solve(spp, dims, None)
+        if prm is None:
+            continue
+        found.append(f"{c.name} ({SppChoice(spp, prm.s, prm.strength, prm.block_dims).label()[len(str(spp)) + 2:-1]})")
+    return f"; {spp} is valid for {', '.join(found)}" if found else ""
 
 
 def get(name: str) -> Construction:

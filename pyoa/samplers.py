@@ -267,9 +267,8 @@ class Sampler:
         i = _int("i", i, 0, self.spp - 1)
         j = _int("j", j, 0, self.dims - 1)
         p = reference.pixel_seed(self.seed, pixel)
-        if self.name == "bose":
-            return reference.bose(i, j, self.s, p, self.offset, self.jitter)
-        return reference.cmjnd(i, j, self.s, self.strength, p, self.offset, self.jitter)
+        c = self._construction
+        return getattr(reference, c.function)(i, j, *c.shape_args(self.params), p, self.offset, self.jitter)
 
 
 def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str = "cmj", jitter: float = 1.0,

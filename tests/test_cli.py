@@ -86,7 +86,7 @@ def test_bad_extension_exits_2(tmp_path, capsys, name):
 
 
 def test_bad_spp_exits_2(tmp_path, capsys):
-    code, _, err = run_cli(["points", "--spp", "120", "--out", tmp_path / "x.npy"], capsys)
+    code, _, err = run_cli(["points", "--spp", "128", "--out", tmp_path / "x.npy"], capsys)
     assert code == 2
     assert "121 (s=11)" in err and "169 (s=13)" in err and "Traceback" not in err
     assert os.listdir(tmp_path) == []
@@ -175,7 +175,7 @@ def test_samplers_command(capsys):
 
 
 def test_spp_command(capsys):
-    code, out, _ = run_cli(["spp", "bose", "--near", "120"], capsys)
+    code, out, _ = run_cli(["spp", "bose", "--near", "128"], capsys)
     assert code == 0
     lines = out.strip().splitlines()
     assert lines[0].split() == ["spp", "s", "t", "dims/block"]

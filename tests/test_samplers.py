@@ -87,7 +87,7 @@ def test_cmjnd_strength_choice(spp, dims, strength, want):
 
 def test_samplers_listing():
     names = pyoa.samplers()
-    assert set(names) == {"bose", "cmjnd"}
+    assert set(names) == {"bose", "bush", "cmjnd"}
     assert all(isinstance(v, str) and v for v in names.values())
 
 
@@ -98,9 +98,11 @@ def test_valid_spp():
     assert all(math.isqrt(c.spp) ** 2 == c.spp for c in bose)
     assert [c.spp for c in bose] == sorted(c.spp for c in bose)
     assert 120 not in [c.spp for c in bose] and 121 in [c.spp for c in bose]
-    assert [c.label() for c in pyoa.valid_spp("bose", near=120)] == ["121 (s=11)", "169 (s=13)"]
-    assert [c.spp for c in pyoa.valid_spp("bose", near=121)] == [121, 169] or \
-        [c.spp for c in pyoa.valid_spp("bose", near=121)] == [49, 121]
+    assert [c.label() for c in pyoa.valid_spp("bose", near=128)] == ["121 (s=11)", "169 (s=13)"]
+    # prime powers count: 81 = 9^2 is nearer to 120 than 169
+    assert [c.label() for c in pyoa.valid_spp("bose", near=120)] == ["81 (s=9)", "121 (s=11)"]
+    # a valid count is its own nearest; the next is 81 (|121-81| = 40 < |169-121| = 48)
+    assert [c.spp for c in pyoa.valid_spp("bose", near=121)] == [81, 121]
     cubes = pyoa.valid_spp("cmjnd", strength=3)
     assert [c.spp for c in cubes] == [s**3 for s in range(2, 257)]
     assert cubes[1].label() == "27 (s=3, t=3)"
@@ -250,8 +252,8 @@ def test_thread_safety_mixed_requests(backend):
 # ----------------------------------------------------------------------------- bad inputs
 
 @pytest.mark.parametrize("kwargs, exc, words", [
-    (dict(name="bose", spp=120), ValueError, ["120", "121 (s=11)", "169 (s=13)"]),
-    (dict(name="bose", spp=100), ValueError, ["100", "prime", "49 (s=7)", "121 (s=11)"]),
+    (dict(name="bose", spp=128), ValueError, ["128", "121 (s=11)", "169 (s=13)"]),
+    (dict(name="bose", spp=100), ValueError, ["100", "prime", "81 (s=9)", "121 (s=11)", "valid for cmjnd (s=10)"]),
     (dict(name="bose", spp=4096**2), ValueError, ["prime", "4093"]),
     (dict(name="bose", spp=4099**2), ValueError, ["spp", "16777216"]),
     (dict(name="bose", spp=0), ValueError, ["spp"]),

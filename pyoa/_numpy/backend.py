@@ -43,11 +43,8 @@ class NumpyBackend:
             out[...] = self._tabled(req, rows, i)
             return
         p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
-        j = req.dims[None, :]
-        if req.construction.name == "bose":
-            out[...] = oa.bose(i, j, prm.s, p, req.offset, req.jitter)
-        else:
-            out[...] = oa.cmjnd(i, j, prm.s, prm.strength, p, req.offset, req.jitter)
+        c = req.construction
+        out[...] = getattr(oa, c.function)(i, req.dims[None, :], *c.shape_args(prm), p, req.offset, req.jitter)
 
     @staticmethod
     def _tabled(req: Request, rows: np.ndarray, i: np.ndarray) -> np.ndarray:
@@ -60,10 +57,11 @@ class NumpyBackend:
         strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])
         col = (req.dims % U32(dmax))[None, :]
         d = np.arange(req.n_dims)[None, :]
-        if req.construction.name == "bose":
-            aij, u = oa.bose_cell(i, col, s)
-        else:
-            aij, u = oa.cmjnd_cell(i, col, s)
+        aij, u = {
+            "bose": lambda: oa.bose_cell(i, col, s),
+            "bush": lambda: oa.bush_cell(i, col, s, prm.strength),
+            "cmjnd": lambda: oa.cmjnd_cell(i, col, s),
+        }[req.construction.name]()
         if req.offset == "cmj":
             subs = permute(np.arange(M, dtype=U32), M, (q * U32(SUBSTRATUM_KEY))[..., None])
             sub = subs[local, d, u].astype(F32)

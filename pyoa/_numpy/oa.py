@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import gf
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import F32, jitter_value, sample_value
 from .hashes import U32, block_seed, permute, randfloat
@@ -24,15 +25,57 @@ def column_key(p, j, dmax: int) -> np.ndarray:
     return block_seed(p, j // U32(dmax)) * (j % U32(dmax) + U32(1))
 
 
+class Field:
+    """GF(q) arithmetic on uint32 code arrays: mod q for prime q, else the
+    lookup tables of :func:`pyoa.gf.tables` (the same tables the kernels read)."""
+
+    def __init__(self, q: int):
+        self.q = q
+        self.tabled = gf.prime_power(q)[1] > 1
+        if self.tabled:
+            self._add, self._mul = (t.astype(U32) for t in gf.tables(q))
+
+    def add(self, a, b):
+        if self.tabled:
+            return self._add[a * U32(self.q) + b]
+        return (a + b) % U32(self.q)
+
+    def mul(self, a, b):
+        if self.tabled:
+            return self._mul[a * U32(self.q) + b]
+        return (a * b) % U32(self.q)
+
+
 def bose_cell(i, col, s: int):
-    """``(A_ij, A_ik)`` of Bose column ``col < s+1`` and its partner column."""
+    """``(A_ij, A_ik)`` of Bose column ``col < s+1`` and its partner column, over GF(s)."""
     i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
+    F = Field(s)
     S = U32(s)
     a0, a1 = i // S, i % S
     k = np.where(col % U32(2) == 1, col - U32(1), col + U32(1))
-    aij = np.where(col == 0, a0, np.where(col == 1, a1, (a0 + (col - U32(1)) * a1) % S))
-    aik = np.where(col == 0, a1, np.where(col == 1, a0, (a0 + ((k - U32(1)) % S) * a1) % S))
+    # Columns 0 and 1 are clipped to multiplier 0 only to keep table indices
+    # in range; np.where then discards those lanes.
+    m_j = np.where(col >= 2, col - U32(1), U32(0)) % S
+    m_k = np.where(col >= 2, k - U32(1), U32(0)) % S
+    aij = np.where(col == 0, a0, np.where(col == 1, a1, F.add(a0, F.mul(m_j, a1))))
+    aik = np.where(col == 0, a1, np.where(col == 1, a0, F.add(a0, F.mul(m_k, a1))))
     return aij, aik
+
+
+def bush_cell(i, col, s: int, t: int):
+    """``(A_ij, u)`` of Bush column ``col < s+1``: the row polynomial at ``col``
+    (or its leading coefficient for ``col == s``) and the sub-stratum index."""
+    i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
+    F = Field(s)
+    S = U32(s)
+    M = U32(s ** (t - 1))
+    x = np.minimum(col, S - U32(1))  # column s evaluates nothing; keep indices in range
+    acc = np.zeros(np.broadcast(i, col).shape, dtype=U32)
+    for l in range(t - 1, -1, -1):  # Horner
+        acc = F.add(F.mul(acc, x), (i // S ** U32(l)) % S)
+    lead = i // (M)  # c_{t-1}
+    last = col == S
+    return np.where(last, lead, acc), np.where(last, i % M, i // S)
 
 
 def cmjnd_cell(i, col, s: int):
@@ -74,4 +117,15 @@ def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> 
     aij, v = cmjnd_cell(i, j % U32(t), s)
     stratum = permute(aij, s, q * U32(STRATUM_KEY))
     sub = offset_sub(offset, v, M, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
+    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)
+
+
+def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.bush` (parameters assumed valid)."""
+    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
+    q = column_key(p, j, s + 1)
+    M = s ** (t - 1)
+    aij, u = bush_cell(i, j % U32(s + 1), s, t)
+    stratum = permute(aij, s, q * U32(STRATUM_KEY))
+    sub = offset_sub(offset, u, M, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
     return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)

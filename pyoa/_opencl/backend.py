@@ -6,7 +6,7 @@ import threading
 
 import numpy as np
 
-from .. import constructions
+from .. import constructions, gf
 from ..request import Request
 from .device import DeviceInfo, select_device
 from .program import build
@@ -38,11 +38,23 @@ class OpenCLBackend:
         # Kernel objects are fetched once (each retrieval builds a new one);
         # their arguments are set under self._lock.
         self._kernels = {k.function_name: k for k in self.program.all_kernels()}
+        self._fields: dict[int, tuple] = {}
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
 
     def describe(self) -> str:
         return self.info.describe()
+
+    def _field(self, q: int) -> tuple:
+        """Kernel arguments ``(gf buffer, tabled)`` for GF(q), uploaded once per q.
+        Called with self._lock held."""
+        if q not in self._fields:
+            import pyopencl as cl
+
+            tab, tabled = _field_tables(q)
+            buf = cl.Buffer(self.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=tab)
+            self._fields[q] = (buf, np.uint32(tabled))
+        return self._fields[q]
 
     def rows_per_chunk(self, n_dims: int) -> int:
         return max(1, self.max_chunk_values // max(1, n_dims))
@@ -65,6 +77,7 @@ class OpenCLBackend:
             # Only the pixels of these rows travel to the device.
             pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
             pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
+            gf_args = self._field(prm.s if req.construction.uses_field else 0)
             if req.tables_pay_off(row0, row1):
                 E = req.table_entries
                 n_entries = (pix1 - pix0) * req.n_dims * E
@@ -74,17 +87,16 @@ class OpenCLBackend:
                     tab, pixels, dims, np.uint32(n_entries), np.uint32(req.n_dims), np.uint32(E),
                     np.uint32(req.seed), np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M),
                 )
-                if req.construction.name == "bose":
-                    kernel, pw = self._kernels["generate_tabled_bose"], [1]
-                else:  # s^col of each CMJND column, all below 2**24
-                    kernel, pw = self._kernels["generate_tabled_cmjnd"], [prm.s**k for k in range(prm.block_dims)]
+                kernel = self._kernels[f"generate_tabled_{req.construction.function}"]
+                # s^col of each CMJND column (all below 2**24); unused otherwise
+                pw = [prm.s**k for k in range(prm.block_dims)] if req.construction.name == "cmjnd" else [1]
                 powers = cl.Buffer(self.context, ro, hostbuf=np.array(pw, dtype=np.uint32))
                 kernel(
                     self.queue, (_padded(n_values),), (GROUP_SIZE,),
                     buf, tab, samples, dims, powers, np.uint32(n_s), np.uint32(req.n_dims),
                     np.uint32(row0 - pix0 * n_s), np.uint32(n_values), np.uint32(E),
-                    np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M),
-                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+                    np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M), np.uint32(prm.strength),
+                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter), *gf_args,
                 )
             else:
                 self._kernels["generate"](
@@ -93,10 +105,20 @@ class OpenCLBackend:
                     np.uint32(n_s), np.uint32(req.n_dims), np.uint32(row0 - pix0 * n_s), np.uint32(n_values),
                     np.uint32(req.seed), np.uint32(req.construction.code),
                     np.uint32(prm.s), np.uint32(prm.strength),
-                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter), *gf_args,
                 )
             cl.enqueue_copy(self.queue, out, buf)
             self.queue.finish()
+
+
+def _field_tables(q: int) -> tuple[np.ndarray, bool]:
+    """GF(q) as the kernels read it: addition then multiplication table, or a
+    1-element placeholder (and tabled = False) for prime q and for q = 0 (a
+    construction without a field)."""
+    if q == 0 or gf.prime_power(q)[1] == 1:
+        return np.zeros(1, np.uint16), False
+    add, mul = gf.tables(q)
+    return np.concatenate([add, mul]), True
 
 
 def _padded(n: int) -> int:

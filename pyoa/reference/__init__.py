@@ -4,10 +4,10 @@ Scalar, one value at a time, written to be read next to ``SPEC.md``. It is
 slow by design; use :func:`pyoa.sampler` for bulk generation.
 
 Public functions: :func:`permute`, :func:`randfloat`, :func:`pixel_seed`,
-:func:`block_seed`, :func:`bose`, :func:`cmjnd`.
+:func:`block_seed`, :func:`bose`, :func:`bush`, :func:`cmjnd`.
 """
 
 from .hashes import block_seed, dimension_seeds, mix32, permute, pixel_seed, randfloat
-from .oa import bose, cmjnd
+from .oa import bose, bush, cmjnd
 
-__all__ = ["permute", "randfloat", "pixel_seed", "block_seed", "dimension_seeds", "mix32", "bose", "cmjnd"]
+__all__ = ["permute", "randfloat", "pixel_seed", "block_seed", "dimension_seeds", "mix32", "bose", "bush", "cmjnd"]

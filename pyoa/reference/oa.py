@@ -22,7 +22,8 @@ References
 
 from __future__ import annotations
 
-from ..constructions import OFFSETS, is_prime
+from .. import gf
+from ..constructions import OFFSETS
 from .floats import f32, jitter_value, sample_value
 from .hashes import MASK, block_seed, dimension_seeds, permute, randfloat
 
@@ -47,10 +48,11 @@ def _centered(M: int) -> float:
 
 
 def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
-    """Bose OA sample, strength 2: ``s`` prime, ``N = s**2``, ``s + 1`` columns per block.
+    """Bose OA sample, strength 2: ``s`` a prime power, ``N = s**2``, ``s + 1`` columns per block.
 
     The integer array is ``A_i0 = i // s``, ``A_i1 = i % s`` and
-    ``A_ij = (A_i0 + (j-1) A_i1) mod s`` for ``2 <= j <= s``. Column ``j`` is
+    ``A_ij = A_i0 + (j-1) A_i1`` in GF(s) for ``2 <= j <= s`` (the multiplier
+    is the field element with code ``j-1``; mod-s arithmetic for prime s). Column ``j`` is
     paired with column ``k`` (1 for 0, 0 for 1, ``j-1`` for odd ``j``, ``j+1``
     for even ``j``, with ``k-1`` taken mod s), whose entry places the point
     inside its coarse stratum: ``M = s`` sub-strata.
@@ -62,7 +64,7 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
     j : int
         Dimension, any ``j >= 0`` (blocks of ``s + 1``).
     s : int
-        Strata per axis, a prime.
+        Strata per axis: a prime, or a prime power up to 256 (:mod:`pyoa.gf`).
     p : int
         Array seed (uint32); 0 is the canonical array.
     offset : {"cmj", "mj", "j", "centered"}
@@ -70,8 +72,8 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
     jitter : float
         Jitter amount J in [0, 1].
     """
-    if not is_prime(s):
-        raise ValueError(f"bose needs s prime, got s={s}")
+    if not gf.is_supported(s):
+        raise ValueError(f"bose needs s prime or a prime power <= {gf.MAX_TABLE_Q}, got s={s}")
     J = _check_common(i, s * s, j, p, offset, jitter)
     block, j = divmod(j, s + 1)
     p = block_seed(p, block)
@@ -84,8 +86,8 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
         aij, aik = a1, a0
     else:
         k = j - 1 if j % 2 else j + 1
-        aij = (a0 + (j - 1) * a1) % s
-        aik = (a0 + ((k - 1) % s) * a1) % s
+        aij = gf.add(a0, gf.mul(j - 1, a1, s), s)
+        aik = gf.add(a0, gf.mul((k - 1) % s, a1, s), s)
 
     stratum = permute(aij, s, P1)
     if offset == "centered":
@@ -147,3 +149,71 @@ def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: f
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
 
 
+
+
+def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
+    """Bush OA sample of strength ``t``: ``s`` a prime power, ``t <= s``, ``N = s**t``, ``s + 1`` columns.
+
+    Row ``i`` has base-``s`` digits ``c_0 .. c_{t-1}`` (``c_0`` least
+    significant), the coefficients of ``f_i(x) = sum_l c_l x**l``. Column
+    ``j < s`` is ``f_i(j)`` evaluated in GF(s); column ``s`` is the leading
+    coefficient ``c_{t-1}``. Two polynomials of degree < t that agree at t
+    points are equal, so every t columns show each t-tuple once: strength t.
+
+    Sub-strata (``M = s**(t-1)``): in column ``j < s``, ``u = i // s`` (the
+    digits ``c_1..c_{t-1}``): inside one coarse stratum ``c_0`` is fixed by the
+    others, so ``u`` takes every value in ``[0, M)`` once. In column ``s`` the
+    stratum *is* ``c_{t-1}``, the top digit of ``i // s``, so there
+    ``u = i mod M`` (the digits ``c_0..c_{t-2}``) instead, which again takes
+    every value once per stratum. With ``permute(u, M, .)`` per stratum
+    (``mj``) or shared by all strata (``cmj``) every column is then a 1D
+    Latin hypercube for every t (the authors' correlated variant kept that
+    only for t = 3; SPEC's ``u = i // s`` for column s would repeat values).
+
+    Parameters
+    ----------
+    i : int
+        Sample index in ``[0, s**t)``.
+    j : int
+        Dimension, any ``j >= 0`` (blocks of ``s + 1``).
+    s : int
+        Strata per axis: a prime, or a prime power up to 256.
+    t : int
+        Strength, ``2 <= t <= s``.
+    p, offset, jitter
+        As for :func:`bose`.
+
+    References
+    ----------
+    .. [1] K. A. Bush, "Orthogonal arrays of index unity", Ann. Math. Statist.
+       23(3), 1952.
+    """
+    if not gf.is_supported(s) or not 2 <= t <= s:
+        raise ValueError(f"bush needs s prime or a prime power <= {gf.MAX_TABLE_Q} and 2 <= t <= s, got s={s}, t={t}")
+    N = s**t
+    J = _check_common(i, N, j, p, offset, jitter)
+    block, j = divmod(j, s + 1)
+    p = block_seed(p, block)
+    P1, P2, P3 = dimension_seeds(p, j)
+
+    M = N // s
+    c = [(i // s**l) % s for l in range(t)]
+    if j < s:
+        aij = 0
+        for coeff in reversed(c):  # Horner: f(j) = (...(c_{t-1} j + c_{t-2}) j + ...) + c_0
+            aij = gf.add(gf.mul(aij, j, s), coeff, s)
+        u = i // s
+    else:
+        aij = c[t - 1]
+        u = i % M
+
+    stratum = permute(aij, s, P1)
+    if offset == "centered":
+        sub = _centered(M)
+    elif offset == "j":
+        sub = permute(u, M, ((i + 1) * P2) & MASK)
+    elif offset == "mj":
+        sub = permute(u, M, ((aij + 1) * P2) & MASK)
+    else:  # cmj
+        sub = permute(u, M, P2)
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)

@@ -32,7 +32,9 @@ __kernel void t_jitter_value(__global const float *r, const float J, __global fl
 
 __kernel void t_bose(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
                      const uint offset, const float J, __global float *out)
-{ size_t g = get_global_id(0); out[g] = bose(i[g], j[g], s, p[g], offset, J); }
+{ size_t g = get_global_id(0);
+  /* prime s only (the C oracle's domain): tabled = 0, so the GF placeholder is never used */
+  out[g] = bose(i[g], j[g], s, p[g], offset, J, (__global const ushort *)p, 0u); }
 
 __kernel void t_cmjnd(__global const uint *i, __global const uint *j, const uint s, const uint t,
                       __global const uint *p, const uint offset, const float J, __global float *out)
