@@ -101,6 +101,12 @@ CASES: dict[str, dict] = {
                           about="Bose s=11, jittered offsets"),
     "bose-centered-121x10": dict(name="bose", spp=121, dims=10, offset="centered", strength=None,
                                  about="Bose s=11, centred in the coarse strata"),
+    "bose-gf-cmj-64x10": dict(name="bose", spp=64, dims=10, offset="cmj", strength=None,
+                               about="Bose over GF(8) (s=8, table arithmetic), correlated multi-jittered offsets"),
+    "bush-cmj-125x10": dict(name="bush", spp=125, dims=10, offset="cmj", strength=3,
+                            about="Bush s=5 t=3, correlated multi-jittered offsets"),
+    "bush-gf-cmj-256x10": dict(name="bush", spp=256, dims=10, offset="cmj", strength=4,
+                               about="Bush over GF(4) (s=4, t=4), correlated multi-jittered offsets"),
 }
 REQUIRED_CASE = "bose-cmj-121x10"
 #: The full set of cases takes about 8 minutes on a 2-core machine (NumPy
