@@ -32,7 +32,8 @@ __kernel void generate(__global float *out,
                        const uint offset,
                        const float J,
                        __global const ushort *gf,
-                       const uint gf_tabled)
+                       const uint gf_tabled,
+                       __global const uint *consts)
 {
     uint gid = (uint)get_global_id(0);
     if (gid >= n_values) return;
@@ -43,6 +44,9 @@ __kernel void generate(__global float *out,
     float x;
     if (construction == CONSTRUCTION_BOSE)      x = bose(i, dim, s, p, offset, J, gf, gf_tabled);
     else if (construction == CONSTRUCTION_BUSH) x = bush(i, dim, s, t, p, offset, J, gf, gf_tabled);
+    else if (construction == CONSTRUCTION_ADDELMAN_KEMPTHORNE)
+        x = addelman_kempthorne(i, dim, s, p, offset, J, gf, gf_tabled, consts);
+    else if (construction == CONSTRUCTION_BOSE_BUSH) x = bose_bush(i, dim, s, p, offset, J, gf, gf_tabled);
     else                                        x = cmjnd(i, dim, s, t, p, offset, J);
     out[gid] = x;
 }
@@ -88,7 +92,8 @@ __kernel void NAME(__global float *out,                                         
                    const uint offset,                                                   \
                    const float J,                                                       \
                    __global const ushort *gf,                                           \
-                   const uint gf_tabled)                                                \
+                   const uint gf_tabled,                                                \
+                   __global const uint *consts)                                         \
 {                                                                                       \
     uint gid = (uint)get_global_id(0);                                                  \
     if (gid >= n_values) return;                                                        \
@@ -108,3 +113,6 @@ __kernel void NAME(__global float *out,                                         
 GENERATE_TABLED(generate_tabled_bose, bose_cell(i, col, s, gf, gf_tabled, &aij, &u))
 GENERATE_TABLED(generate_tabled_bush, bush_cell(i, col, s, t, M, gf, gf_tabled, &aij, &u))
 GENERATE_TABLED(generate_tabled_cmjnd, cmjnd_cell(i, s, powers[col], &aij, &u))
+GENERATE_TABLED(generate_tabled_addelman_kempthorne,
+                addelman_kempthorne_cell(i, col, s, gf, gf_tabled, consts, &aij, &u))
+GENERATE_TABLED(generate_tabled_bose_bush, bose_bush_cell(i, col, s, gf, gf_tabled, &aij, &u))

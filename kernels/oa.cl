@@ -102,3 +102,59 @@ float bush(uint i, uint j, uint s, uint t, uint p, uint offset, float J, __globa
     float sub = offset_sub(offset, u, M, i + 1u, aij, q * SUBSTRATUM_KEY);
     return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J);
 }
+
+/* Addelman-Kempthorne: A_ij of column j < 2q+1 and the sub-stratum index u
+ * (see reference.addelman_kempthorne). ak = [kappa, b[0..q), k[0..q), c[0..q)]
+ * from pyoa.gf.ak_constants. Columns 1..q-1 use m = j, columns q..2q-1 use
+ * m = j - q (k[0] = c[0] = 0 makes m = 0 column q); multipliers of other
+ * columns are clamped to 0 so every lookup stays in range. */
+void addelman_kempthorne_cell(uint i, uint j, uint q, __global const ushort *gf, uint tabled,
+                              __global const uint *ak, uint *aij, uint *u)
+{
+    uint h = i / (q * q), x = (i / q) % q, y = i % q;
+    uint x2 = gf_mul(x, x, q, gf, tabled);
+    uint kappa = ak[0];
+    uint mA = (j >= 1u && j < q) ? j : 0u;
+    uint mB = (j >= q && j < 2u * q) ? j - q : 0u;
+    uint colA = gf_add(gf_add(x, gf_mul(mA, y, q, gf, tabled), q, gf, tabled), h ? ak[1u + mA] : 0u, q, gf, tabled);
+    uint kx = gf_mul(h ? ak[1u + q + mB] : mB, x, q, gf, tabled);
+    uint sq = h ? gf_mul(kappa, x2, q, gf, tabled) : x2;
+    uint colB = gf_add(gf_add(gf_add(y, kx, q, gf, tabled), sq, q, gf, tabled), h ? ak[1u + 2u * q + mB] : 0u, q, gf, tabled);
+    *aij = (j == 0u) ? y : (j < q) ? colA : (j < 2u * q) ? colB : x;
+    *u = h * q + ((j == 0u || (j >= q && j < 2u * q)) ? x : y);
+}
+
+/* Bose-Bush in GF(2s): column j < 2s is low_r(x * j) XOR k, column 2s is
+ * x mod s, for row i = x s + k (see reference.bose_bush). */
+void bose_bush_cell(uint i, uint j, uint s, __global const ushort *gf, uint tabled, uint *aij, uint *u)
+{
+    uint x = i / s, k = i % s;
+    uint a = (gf_mul(x, min(j, 2u * s - 1u), 2u * s, gf, tabled) % s) ^ k;
+    *aij = (j < 2u * s) ? a : x % s;
+    *u = (j < 2u * s) ? x : (x / s) * s + k;
+}
+
+/* The index-2 constructions share M = 2s, 2s+1 columns and the 'j' seed i+1. */
+float index2_value(uint i, uint j, uint s, uint aij, uint u, uint q, uint offset, float J)
+{
+    uint stratum = permute(aij, s, q * STRATUM_KEY);
+    float sub = offset_sub(offset, u, 2u * s, i + 1u, aij, q * SUBSTRATUM_KEY);
+    return oa_value(i, stratum, sub, q * JITTER_KEY, 2u * s, s, J);
+}
+
+float addelman_kempthorne(uint i, uint j, uint s, uint p, uint offset, float J,
+                          __global const ushort *gf, uint tabled, __global const uint *ak)
+{
+    uint q = column_key(p, j, 2u * s + 1u);
+    uint aij, u;
+    addelman_kempthorne_cell(i, j % (2u * s + 1u), s, gf, tabled, ak, &aij, &u);
+    return index2_value(i, j, s, aij, u, q, offset, J);
+}
+
+float bose_bush(uint i, uint j, uint s, uint p, uint offset, float J, __global const ushort *gf, uint tabled)
+{
+    uint q = column_key(p, j, 2u * s + 1u);
+    uint aij, u;
+    bose_bush_cell(i, j % (2u * s + 1u), s, gf, tabled, &aij, &u);
+    return index2_value(i, j, s, aij, u, q, offset, J);
+}

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import NamedTuple
 
 from . import gf
@@ -132,9 +133,17 @@ class Construction:
     name: str
     code: int
     description: str
-    #: whether the integer array is computed in GF(s) (the backends then need
-    #: pyoa.gf's tables for prime-power s)
+    #: whether the integer array is computed in a Galois field (the backends
+    #: then need pyoa.gf's tables for prime-power orders); see field_order
     uses_field = False
+
+    def field_order(self, params: Params) -> int:
+        """Order of the field the array is computed in (0: none)."""
+        return params.s if self.uses_field else 0
+
+    def constants(self, params: Params) -> list[int]:
+        """Per-construction constants the kernels read (empty: none)."""
+        return []
 
     @property
     def function(self) -> str:
@@ -211,13 +220,14 @@ class Bush(Construction):
     name = "bush"
     code = 2
     uses_field = True
+    #: t <= s and s**t <= 2**24 allow t <= 8 (8**8 = 2**24; 9**9 is too large)
+    max_strength = 8
     description = "Bush OA, strength t: N = s^t with s a prime power and t <= s, s+1 dimensions per block"
 
-    @staticmethod
-    def _strengths(dims, strength):
+    def _strengths(self, dims, strength):
         if strength is not None:
             return [strength]
-        return list(range(2, max(2, min(dims or 24, 24)) + 1))
+        return list(range(2, max(2, min(dims or self.max_strength, self.max_strength)) + 1))
 
     def choices(self, dims=None, strength=None):
         out = []
@@ -240,8 +250,11 @@ class Bush(Construction):
         return nearest(cands, spp)
 
     def solve(self, spp, dims, strength):
-        if strength is not None and not 2 <= strength <= 24:
-            raise ValueError(f"bush strength must be an integer in [2, 24], got {strength}")
+        if strength is not None and not 2 <= strength <= self.max_strength:
+            raise ValueError(
+                f"bush strength must be an integer in [2, {self.max_strength}] (t <= s and s^t <= 2^24), "
+                f"got {strength}; use 'cmjnd' for higher strengths"
+            )
         # The largest t <= dims (t >= 2): the most dimensions stratified jointly.
         for t in sorted(self._strengths(dims, strength), reverse=True):
             s = integer_root(spp, t)
@@ -311,7 +324,78 @@ class CMJND(Construction):
         return f"{spp} is not s^t with s >= 2 for any strength {ts[0]} <= t <= {ts[-1]} (dims={dims})"
 
 
-CONSTRUCTIONS: dict[str, Construction] = {c.name: c for c in (Bose(), Bush(), CMJND())}
+class _Index2(Construction):
+    """Shared parts of the strength-2, index-2 constructions: N = 2 s**2,
+    2s + 1 dimensions per block, M = 2s sub-strata."""
+
+    uses_field = True
+
+    def shape_args(self, params):
+        return (params.s,)
+
+    def levels(self):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def choices(self, dims=None, strength=None):
+        if strength not in (None, 2):
+            return []
+        return [SppChoice(2 * s * s, s, 2, 2 * s + 1) for s in self.levels()]
+
+    def solve(self, spp, dims, strength):
+        if strength not in (None, 2):
+            raise ValueError(f"{self.name} has strength 2 only (got strength={strength})")
+        s = math.isqrt(spp // 2)
+        if spp % 2 or 2 * s * s != spp or s not in self.levels():
+            return None
+        return Params(s=s, strength=2, block_dims=2 * s + 1, M=2 * s)
+
+
+class AddelmanKempthorne(_Index2):
+    """Addelman and Kempthorne (1961): strength 2, index 2, q an odd prime power,
+    N = 2 q**2, 2q + 1 dimensions per block."""
+
+    name = "addelman-kempthorne"
+    code = 3
+    description = ("Addelman-Kempthorne OA, strength 2, index 2: N = 2q^2 with q an odd prime power, "
+                   "2q+1 dimensions per block")
+
+    @staticmethod
+    @lru_cache(maxsize=None)
+    def levels():
+        top = math.isqrt(MAX_SPP // 2)
+        return tuple(q for q in range(3, top + 1, 2) if gf.is_supported(q))
+
+    def constants(self, params):
+        kappa, b, k, c = gf.ak_constants(params.s)
+        return [kappa, *b, *k, *c]
+
+    def invalid(self, spp, dims, strength):
+        return (f"{spp} is not 2q^2 with q an odd prime (<= {self.levels()[-1]}) "
+                f"or odd prime power (<= {gf.MAX_TABLE_Q})")
+
+
+class BoseBush(_Index2):
+    """Bose and Bush (1952): strength 2, index 2, s a power of two,
+    N = 2 s**2, 2s + 1 dimensions per block, computed in GF(2s)."""
+
+    name = "bose-bush"
+    code = 4
+    description = "Bose-Bush OA, strength 2, index 2: N = 2s^2 with s a power of two, 2s+1 dimensions per block"
+
+    @staticmethod
+    def levels():
+        return tuple(2**r for r in range(1, 8))  # GF(2s) tables up to 256
+
+    def field_order(self, params):
+        return 2 * params.s
+
+    def invalid(self, spp, dims, strength):
+        return f"{spp} is not 2s^2 with s a power of two (<= {self.levels()[-1]}, GF(2s) tables up to {gf.MAX_TABLE_Q})"
+
+
+CONSTRUCTIONS: dict[str, Construction] = {
+    c.name: c for c in (Bose(), Bush(), CMJND(), AddelmanKempthorne(), BoseBush())
+}
 
 
 def _elsewhere(this: Construction, spp: int, dims: int | None) -> str:

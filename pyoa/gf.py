@@ -34,6 +34,7 @@ import numpy as np
 MAX_TABLE_Q = 256
 
 
+@lru_cache(maxsize=None)
 def prime_power(q: int) -> tuple[int, int] | None:
     """``(p, r)`` with ``q == p**r`` and p prime, or None if q is not a prime power."""
     if q < 2:
@@ -141,3 +142,49 @@ def tables(q: int) -> tuple[np.ndarray, np.ndarray]:
     add_t.flags.writeable = False
     mul_t.flags.writeable = False
     return add_t, mul_t
+
+
+def inverse(a: int, q: int) -> int:
+    """The multiplicative inverse of ``a != 0`` in GF(q): ``a**(q-2)``, since
+    the multiplicative group has order q - 1 (square-and-multiply)."""
+    if a == 0:
+        raise ZeroDivisionError("0 has no inverse")
+    result, base, e = 1, a, q - 2
+    while e:
+        if e & 1:
+            result = mul(result, base, q)
+        base = mul(base, base, q)
+        e >>= 1
+    return result
+
+
+def neg(a: int, q: int) -> int:
+    """``-a`` in GF(q): each base-p digit negated mod p."""
+    p, r = prime_power(q)
+    return _code([(-d) % p for d in _digits(a, p, r)], p)
+
+
+@lru_cache(maxsize=None)
+def ak_constants(q: int) -> tuple[int, tuple[int, ...], tuple[int, ...], tuple[int, ...]]:
+    """Constants of the Addelman-Kempthorne construction over GF(q), q odd.
+
+    Returns ``(kappa, b, k, c)`` with ``kappa`` the smallest non-square of
+    GF(q) (by code) and, for ``m = 1 .. q-1`` (index 0 unused, 0):
+    ``b[m] = (kappa - 1) / (4 kappa m)``, ``k[m] = kappa m`` and
+    ``c[m] = m**2 (kappa - 1) / 4``, the values of Addelman and Kempthorne
+    (1961) as tabulated in Hedayat, Sloane and Stufken, "Orthogonal Arrays"
+    (1999), section 3.4.
+    """
+    p, _ = prime_power(q)
+    if p == 2:
+        raise ValueError(f"Addelman-Kempthorne needs q odd, got {q}")
+    squares = {mul(x, x, q) for x in range(q)}
+    kappa = next(x for x in range(1, q) if x not in squares)
+    four = 4 % p  # the field element 4 = 1 + 1 + 1 + 1 (1 when p = 3)
+    num = add(kappa, neg(1, q), q)  # kappa - 1
+    b, k, c = [0] * q, [0] * q, [0] * q
+    for m in range(1, q):
+        b[m] = mul(num, inverse(mul(mul(kappa, four, q), m, q), q), q)
+        k[m] = mul(kappa, m, q)
+        c[m] = mul(mul(mul(m, m, q), num, q), inverse(four, q), q)
+    return kappa, tuple(b), tuple(k), tuple(c)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import subprocess
 from pathlib import Path
@@ -97,8 +98,12 @@ def reference_block(smp, pixels, samples, dims) -> np.ndarray:
             for c, j in enumerate(dims):
                 if smp.name == "bose":
                     out[a, b, c] = ref.bose(int(i), int(j), smp.s, p, smp.offset, smp.jitter)
-                else:
+                elif smp.name == "bush":
+                    out[a, b, c] = ref.bush(int(i), int(j), smp.s, smp.strength, p, smp.offset, smp.jitter)
+                elif smp.name == "cmjnd":
                     out[a, b, c] = ref.cmjnd(int(i), int(j), smp.s, smp.strength, p, smp.offset, smp.jitter)
+                else:  # a new construction must be added here, not silently compared to another one
+                    raise AssertionError(f"reference_block does not know sampler {smp.name!r}")
     return out
 
 
@@ -134,6 +139,221 @@ def bose_partner_symbol(i: int, j: int, s: int) -> int:
     return (a0 + ((k - 1) % s) * a1) % s
 
 
+# --------------------------------------------------------------------------- an independent GF(q)
+
+def factor_prime_power(q: int) -> tuple[int, int] | None:
+    """``(p, r)`` with ``q == p**r``, p prime (trial division up to sqrt(q)), else None."""
+    if q < 2:
+        return None
+    p = next((d for d in range(2, int(q**0.5) + 1) if q % d == 0), q)
+    r, rest = 0, q
+    while rest % p == 0:
+        rest //= p
+        r += 1
+    return (p, r) if rest == 1 else None
+
+
+#: Every prime power that is not a prime, up to 256 (pyoa.gf's table limit).
+GF_POWERS = [4, 8, 9, 16, 25, 27, 32, 49, 64, 81, 121, 125, 128, 169, 243, 256]
+
+#: Moduli (coefficients, constant term first) of GF(q): the classic ones
+#: x^2+x+1, x^3+x+1, x^4+x+1 and AES's x^8+x^4+x^3+x+1, and for 9, 25, 27 the
+#: first monic irreducible by coefficient code (x^2+1, x^2+2, x^3+2x+1, checked
+#: by hand: no roots).
+KNOWN_MODULI = {
+    4: (1, 1, 1),
+    8: (1, 1, 0, 1),
+    9: (1, 0, 1),
+    16: (1, 1, 0, 0, 1),
+    25: (2, 0, 1),
+    27: (1, 2, 0, 1),
+    256: (1, 1, 0, 1, 1, 0, 0, 0, 1),
+}
+
+
+def _trim(a: list[int]) -> list[int]:
+    while a and a[-1] == 0:
+        a = a[:-1]
+    return a
+
+
+def poly_rem(a: list[int], f: list[int], p: int) -> list[int]:
+    """``a mod f`` over GF(p) (coefficient lists, constant first; any nonzero lead of f)."""
+    a = _trim([x % p for x in a])
+    f = _trim([x % p for x in f])
+    inv = pow(f[-1], -1, p)
+    while len(a) >= len(f):
+        c = a[-1] * inv % p
+        shift = len(a) - len(f)
+        for k, y in enumerate(f):
+            a[shift + k] = (a[shift + k] - c * y) % p
+        a = _trim(a)
+    return a
+
+
+def poly_mul(a: list[int], b: list[int], p: int) -> list[int]:
+    out = [0] * max(0, len(a) + len(b) - 1)
+    for k, x in enumerate(a):
+        for m, y in enumerate(b):
+            out[k + m] = (out[k + m] + x * y) % p
+    return _trim(out)
+
+
+def poly_gcd(a: list[int], b: list[int], p: int) -> list[int]:
+    a, b = _trim([x % p for x in a]), _trim([x % p for x in b])
+    while b:
+        a, b = b, poly_rem(a, b, p)
+    return a
+
+
+def poly_x_pow_p_pow(m: int, f: list[int], p: int) -> list[int]:
+    """``x**(p**m) mod f`` over GF(p), by m Frobenius steps (square-and-multiply each)."""
+    g = poly_rem([0, 1], f, p)
+    for _ in range(m):
+        result, base, e = [1], g, p
+        while e:
+            if e & 1:
+                result = poly_rem(poly_mul(result, base, p), f, p)
+            base = poly_rem(poly_mul(base, base, p), f, p)
+            e >>= 1
+        g = result
+    return g
+
+
+def is_irreducible(f: list[int], p: int) -> bool:
+    """Rabin's test: monic f of degree r is irreducible over GF(p) iff
+    ``x**(p**r) == x mod f`` and ``gcd(x**(p**(r/k)) - x, f) == 1`` for every prime k | r."""
+    r = len(f) - 1
+    if poly_x_pow_p_pow(r, f, p) != poly_rem([0, 1], f, p):
+        return False
+    for k in {k for k in range(2, r + 1) if r % k == 0 and factor_prime_power(k) == (k, 1)}:
+        h = poly_x_pow_p_pow(r // k, f, p) + [0, 0]
+        h[1] = (h[1] - 1) % p  # x**(p**(r/k)) - x
+        h = _trim(h)
+        if not h or len(poly_gcd(f, h, p)) != 1:  # f divides it, or a nonconstant common factor
+            return False
+    return True
+
+
+class PolyField:
+    """GF(p**r) written independently of pyoa.gf: elements are codes whose base-p
+    digits are polynomial coefficients (constant term least significant, SPEC
+    section 5), multiplied as polynomials and reduced by the monic modulus ``f``."""
+
+    def __init__(self, q: int, f):
+        self.q = q
+        self.p, self.r = factor_prime_power(q)
+        self.f = list(f)
+        assert len(self.f) == self.r + 1 and self.f[-1] == 1
+
+    def digits(self, a: int) -> list[int]:
+        return [(a // self.p**k) % self.p for k in range(self.r)]
+
+    def code(self, coeffs: list[int]) -> int:
+        return sum((c % self.p) * self.p**k for k, c in enumerate(coeffs))
+
+    def add(self, a: int, b: int) -> int:
+        return self.code([x + y for x, y in zip(self.digits(a), self.digits(b))])
+
+    def mul(self, a: int, b: int) -> int:
+        return self.code(poly_rem(poly_mul(self.digits(a), self.digits(b), self.p), self.f, self.p))
+
+    def poly_at(self, coeffs: list[int], x: int) -> int:
+        """``sum_l coeffs[l] * x**l`` in the field, term by term (not Horner)."""
+        acc, xp = 0, 1
+        for c in coeffs:
+            acc = self.add(acc, self.mul(c, xp))
+            xp = self.mul(xp, x)
+        return acc
+
+
+def prime_field(q: int) -> PolyField:
+    return PolyField(q, (0, 1))
+
+
+def field_for(q: int) -> PolyField:
+    """GF(q) for prime q (mod q); else over the modulus of :data:`KNOWN_MODULI`, or
+    for the other q pyoa.gf's modulus (tests/test_gf.py checks it is the first
+    monic irreducible polynomial, independently)."""
+    if factor_prime_power(q)[1] == 1:
+        return prime_field(q)
+    from pyoa import gf
+
+    return PolyField(q, KNOWN_MODULI.get(q) or gf.modulus(q))
+
+
+def gf_bose_symbol(i: int, j: int, F: PolyField) -> int:
+    """A_ij of the plain Bose array over GF(q): a0 + (j-1) a1 for 2 <= j <= q."""
+    a0, a1 = divmod(i, F.q)
+    if j == 0:
+        return a0
+    if j == 1:
+        return a1
+    return F.add(a0, F.mul(j - 1, a1))
+
+
+def gf_bose_partner_symbol(i: int, j: int, F: PolyField) -> int:
+    k = bose_partner(j, F.q)
+    a0, a1 = divmod(i, F.q)
+    if k == 0:
+        return a0
+    if k == 1:
+        return a1
+    return F.add(a0, F.mul((k - 1) % F.q, a1))
+
+
+def bush_symbol(i: int, j: int, t: int, F: PolyField) -> int:
+    """A_ij of the plain Bush array: the row polynomial (base-s digits of i,
+    constant term = least significant digit) at x = j < s; its leading coefficient for j = s."""
+    s = F.q
+    c = [(i // s**l) % s for l in range(t)]
+    return c[t - 1] if j == s else F.poly_at(c, j)
+
+
+@functools.lru_cache(maxsize=None)
+def field_tables(q: int) -> tuple[np.ndarray, np.ndarray]:
+    """(add, mul) q x q tables of :func:`field_for` (independent of pyoa.gf), cached."""
+    F = field_for(q)
+    add = np.array([[F.add(a, b) for b in range(q)] for a in range(q)], dtype=np.int64)
+    mul = np.array([[F.mul(a, b) for b in range(q)] for a in range(q)], dtype=np.int64)
+    return add, mul
+
+
+@functools.lru_cache(maxsize=None)
+def plain_bush_array(s: int, t: int) -> np.ndarray:
+    """The whole plain Bush array (N, s+1) of :func:`bush_symbol`, vectorized over
+    :func:`field_tables`, term by term; read-only and cached."""
+    add, mul = field_tables(s)
+    i = np.arange(s**t)
+    c = [(i // s**l) % s for l in range(t)]
+    A = np.empty((s**t, s + 1), dtype=np.int64)
+    for x in range(s):
+        acc, xp = np.zeros_like(i), 1
+        for l in range(t):
+            acc = add[acc, mul[c[l], xp]]
+            xp = int(mul[xp, x])
+        A[:, x] = acc
+    A[:, s] = c[t - 1]
+    A.flags.writeable = False
+    return A
+
+
+@functools.lru_cache(maxsize=None)
+def plain_gf_bose_array(q: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, A_partner)``, each (q^2, q+1), of :func:`gf_bose_symbol`; read-only, cached."""
+    F = field_for(q)
+    A = np.array([[gf_bose_symbol(i, j, F) for j in range(q + 1)] for i in range(q * q)])
+    Ak = np.array([[gf_bose_partner_symbol(i, j, F) for j in range(q + 1)] for i in range(q * q)])
+    A.flags.writeable = Ak.flags.writeable = False
+    return A, Ak
+
+
+def bush_sub_index(i: int, j: int, s: int, t: int) -> int:
+    """The sub-stratum index u of pyoa's Bush (reference.oa.bush): i // s in
+    columns j < s, i mod s**(t-1) in column s (the documented deviation from SPEC)."""
+    return i % s ** (t - 1) if j == s else i // s
+
+
 # --------------------------------------------------------------------------- OA / LH checks
 
 def strata_exact(x: np.ndarray, s: int) -> np.ndarray:
@@ -153,13 +373,15 @@ def assert_oa(strata: np.ndarray, s: int, t: int, cols=None, what: str = "") -> 
     lam, rem = divmod(N, s**t)
     assert rem == 0
     cols = range(d) if cols is None else cols
+    arrays = strata.reshape(-1, N, d)
+    n = len(arrays)
+    base = (np.arange(n, dtype=np.int64) * s**t)[:, None]  # one run of s^t cells per array
     for sub in itertools.combinations(cols, t):
-        code = np.zeros(strata.shape[:-1], dtype=np.int64)
+        code = np.zeros((n, N), dtype=np.int64)
         for c in sub:
-            code = code * s + strata[..., c]
-        counts = np.sort(code, axis=-1)
-        want = np.repeat(np.arange(s**t), lam)
-        ok = np.all(counts == want, axis=-1)
+            code = code * s + arrays[:, :, c]
+        counts = np.bincount((code + base).ravel(), minlength=n * s**t).reshape(n, s**t)
+        ok = np.all(counts == lam, axis=-1)
         assert np.all(ok), f"{what}: columns {sub} are not an OA(strength {t}) in {np.size(ok) - np.count_nonzero(ok)} arrays"
 
 

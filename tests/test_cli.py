@@ -223,3 +223,27 @@ def test_unusable_explicit_backend_exits_2(tmp_path, capsys, monkeypatch):
     assert code == 2
     assert "simulated: no OpenCL platform" in err
     assert os.listdir(tmp_path) == []
+
+
+# ----------------------------------------------------------------------------- Bush and GF Bose from the CLI
+
+def test_points_bush_equals_api(tmp_path, capsys, backend):
+    out = tmp_path / "b.npy"
+    code, _, _ = run_cli(["points", "--sampler", "bush", "--spp", "64", "--strength", "3", "--dims", "11",
+                          "--pixels", "2", "--seed", "4", "--backend", backend, "--out", out, "-q"], capsys)
+    assert code == 0
+    want = pyoa.sampler("bush", spp=64, strength=3, dims=11, seed=4, backend=backend).generate(pixels=range(2))
+    assert_same_bits(np.load(out), want)
+
+
+def test_cli_bush_and_gf_bose_listing_and_errors(tmp_path, capsys):
+    code, out, _ = run_cli(["samplers"], capsys)
+    assert code == 0 and "\nbush" in out
+    code, out, _ = run_cli(["spp", "bush", "--strength", "8"], capsys)
+    assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == [["16777216", "8", "8", "9"]]
+    code, out, _ = run_cli(["spp", "bose", "--near", "70"], capsys)
+    assert code == 0 and [ln.split()[:2] for ln in out.strip().splitlines()[1:]] == [["64", "8"], ["81", "9"]]
+    code, _, err = run_cli(["points", "--sampler", "bush", "--spp", "8", "--strength", "3", "--dims", "4",
+                            "--out", tmp_path / "x.npy"], capsys)
+    assert code == 2 and "27 (s=3, t=3)" in err and "64 (s=4, t=3)" in err
+    assert not (tmp_path / "x.npy").exists()

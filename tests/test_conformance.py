@@ -13,8 +13,10 @@ from hypothesis import strategies as st
 import pyoa
 from pyoa import reference as ref
 from pyoa._numpy import hashes as nh
+from pyoa import gf
 from tests.helpers import (
     BOSE_PRIMES,
+    GF_POWERS,
     PIXEL_KEY,
     U32_MAX,
     assert_same_bits,
@@ -24,6 +26,7 @@ from tests.helpers import (
 
 OFFSETS = ["centered", "j", "mj", "cmj"]
 SMALL_BOSE = [2, 3, 5, 7, 11, 13]
+SMALL_GF = [4, 8, 9, 16, 25, 27]
 
 
 def zero_hash_pixel(seed: int) -> int:
@@ -41,12 +44,26 @@ def max_s(t: int) -> int:
     return s
 
 
+def bush_s(t: int) -> list[int]:
+    """Every s of Bush at strength t: s a prime or a prime power <= 256, s >= t, s^t <= 2^24."""
+    return [s for s in range(t, max_s(t) + 1) if gf.is_supported(s)]
+
+
+BUSH_S = {t: bush_s(t) for t in range(2, 9)}
+
+
 @st.composite
 def configs(draw):
-    name = draw(st.sampled_from(["bose", "cmjnd"]))
+    name = draw(st.sampled_from(["bose", "bush", "cmjnd"]))
     if name == "bose":
-        s = draw(st.sampled_from(SMALL_BOSE) | st.sampled_from(BOSE_PRIMES))
+        s = draw(st.sampled_from(SMALL_BOSE) | st.sampled_from(SMALL_GF) | st.sampled_from(GF_POWERS)
+                 | st.sampled_from(BOSE_PRIMES))
         t, spp, block = 2, s * s, s + 1
+    elif name == "bush":
+        t = draw(st.integers(2, 8))
+        ok = BUSH_S[t]
+        s = draw(st.sampled_from([v for v in ok if v <= 16] or ok) | st.sampled_from(ok) | st.just(ok[-1]))
+        spp, block = s**t, s + 1
     else:
         t = draw(st.integers(1, 24))
         hi = max_s(t)
@@ -63,7 +80,10 @@ def configs(draw):
     pixels = draw(st.lists(st.sampled_from([0, U32_MAX, zero_hash_pixel(seed)]) | st.integers(0, U32_MAX),
                            min_size=1, max_size=2 if many else 3))
     if many:
-        n = min(spp, draw(st.integers(1, 300)))
+        # the pure-Python reference of GF arithmetic costs ~1 ms a value at s ~ 4093
+        # (pyoa.gf factors s on every call); such s never reach the table path (E > 300) anyway
+        slow = name != "cmjnd" and s > 256
+        n = min(spp, draw(st.integers(1, 24 if slow else 300)))
         start = draw(st.integers(0, spp - n))
         samples = list(range(start, start + n))
         if draw(st.booleans()):
@@ -78,8 +98,10 @@ def configs(draw):
 
 
 def make_sampler(cfg, backend):
-    return pyoa.sampler(cfg["name"], spp=cfg["spp"], dims=cfg["dims"], seed=cfg["seed"], offset=cfg["offset"],
-                        jitter=cfg["jitter"], strength=cfg["t"] if cfg["name"] == "cmjnd" else None, backend=backend)
+    smp = pyoa.sampler(cfg["name"], spp=cfg["spp"], dims=cfg["dims"], seed=cfg["seed"], offset=cfg["offset"],
+                       jitter=cfg["jitter"], strength=cfg["t"] if cfg["name"] != "bose" else None, backend=backend)
+    assert (smp.s, smp.strength) == (cfg["s"], cfg["t"])
+    return smp
 
 
 def _cfg(name, s, t, dims, seed, offset, jitter, pixels, samples, dim_idx):
@@ -97,6 +119,19 @@ def _cfg(name, s, t, dims, seed, offset, jitter, pixels, samples, dim_idx):
 @example(cfg=_cfg("bose", 2, 2, 7, 0, "j", 0.0, [zero_hash_pixel(0)], [0, 3], [0, 2, 3, 6]))
 @example(cfg=_cfg("bose", 13, 2, 30, 5, "cmj", 1.0, [1, U32_MAX], list(range(169)), [0, 13, 14, 29]))
 @example(cfg=_cfg("cmjnd", 3, 4, 9, 6, "centered", 0.3, [2], list(range(80, -1, -1)), [0, 3, 4, 8]))
+# GF(256), the largest table: last sample, last column (j = q), past the block
+@example(cfg=_cfg("bose", 256, 2, 3 * 257, U32_MAX, "mj", 1.0, [0, U32_MAX], [0, 257, 256**2 - 1],
+                  [0, 1, 2, 255, 256, 257, 513, 514, 3 * 257 - 1]))
+@example(cfg=_cfg("bose", 243, 2, 250, 0, "cmj", 1.0, [5], list(range(243**2 - 600, 243**2)), [0, 242, 243, 244, 249]))
+# Bush: largest t at small s, the largest N = 8^8 = 2^24, last column j = s, past the block
+@example(cfg=_cfg("bush", 8, 8, 3 * 9 + 1, 0, "cmj", 1.0, [1], [0, 1, 2**21, 2**24 - 1], [0, 7, 8, 9, 17, 26, 27]))
+@example(cfg=_cfg("bush", 7, 7, 17, U32_MAX, "j", 0.5, [U32_MAX], [0, 7**6, 7**7 - 1], [0, 6, 7, 8, 16]))
+@example(cfg=_cfg("bush", 5, 5, 13, 9, "mj", 1.0, [0, 3], [0, 1, 3124, 624, 625], [0, 4, 5, 6, 12]))
+@example(cfg=_cfg("bush", 4, 4, 11, U32_MAX, "cmj", 1.0, [2, 3], list(range(256)), [0, 3, 4, 5, 9, 10]))
+@example(cfg=_cfg("bush", 4, 4, 6, 0, "centered", 0.0, [7], list(range(255, -1, -1)), [0, 4, 5]))
+@example(cfg=_cfg("bush", 256, 3, 258, 3, "cmj", 1.0, [0], [0, 65536, 2**24 - 1], [0, 1, 255, 256, 257]))
+@example(cfg=_cfg("bush", 4093, 2, 4095, 1, "mj", 1.0, [4], [0, 4093, 4093**2 - 1], [0, 4092, 4093, 4094]))
+@example(cfg=_cfg("bush", 27, 3, 30, 11, "cmj", 0.75, [1, 2], list(range(19683 - 900, 19683)), [0, 26, 27, 28, 29]))
 def test_backend_matches_reference(backend, cfg):
     smp = make_sampler(cfg, backend)
     assert smp.backend == backend
@@ -126,7 +161,9 @@ def test_opencl_matches_numpy_in_bulk(cfg, n_pixels):
 
 @pytest.mark.parametrize("offset", ["cmj", "centered", "mj"])
 @pytest.mark.parametrize("name, spp, strength", [("bose", 49, None), ("cmjnd", 27, 3), ("cmjnd", 16, 2),
-                                                 ("bose", 961, None), ("cmjnd", 256, 4)])
+                                                 ("bose", 961, None), ("cmjnd", 256, 4),
+                                                 ("bose", 64, None), ("bose", 729, None), ("bush", 64, 3),
+                                                 ("bush", 81, 2), ("bush", 625, 4), ("bush", 27, 3)])
 def test_table_path_threshold(backend, name, spp, strength, offset):
     """Both backends switch to precomputed permutation tables for `cmj` and
     `centered` once the samples per pixel reach the table size (s, plus M for
@@ -141,22 +178,31 @@ def test_table_path_threshold(backend, name, spp, strength, offset):
         assert_same_bits(got, reference_block(smp, [3, U32_MAX], samples, range(7)), f"{n} samples")
 
 
-def test_table_path_with_chunks(monkeypatch, backend):
+@pytest.mark.parametrize("name, spp, strength, check_dims", [
+    ("bose", 121, None, [0, 5, 11, 12, 13]),
+    ("bose", 81, None, [0, 5, 9, 10, 13]),     # GF(9)
+    ("bush", 125, 3, [0, 5, 6, 11, 13]),       # last column j = s, and past the block
+    ("bush", 256, 4, [0, 3, 4, 5, 13]),        # GF(4), t = s
+])
+def test_table_path_with_chunks(monkeypatch, backend, name, spp, strength, check_dims):
     import pyoa._numpy.backend as nb
 
-    smp = pyoa.sampler("bose", spp=121, dims=14, seed=2, backend=backend)
-    want = reference_block(smp, [7, 8], range(121), [0, 5, 11, 12, 13])
+    smp = pyoa.sampler(name, spp=spp, dims=14, strength=strength, seed=2, backend=backend)
+    want = reference_block(smp, [7, 8], range(spp), check_dims)
     if backend == "numpy":
         monkeypatch.setattr(nb, "CHUNK_VALUES", 14 * 50)
     else:
         monkeypatch.setattr(smp._backend, "max_chunk_values", 14 * 50)
     got = smp.generate(pixels=[7, 8])  # 50-row chunks split both pixels' samples
-    assert_same_bits(got[:, :, [0, 5, 11, 12, 13]], want)
+    assert_same_bits(got[:, :, check_dims], want)
 
 
 SAMPLER_CASES = [
     pytest.param(dict(name="bose", spp=49, dims=17, strength=None), id="bose-s7"),
     pytest.param(dict(name="cmjnd", spp=125, dims=10, strength=3), id="cmjnd-s5-t3"),
+    pytest.param(dict(name="bose", spp=81, dims=21, strength=None), id="bose-gf9"),
+    pytest.param(dict(name="bush", spp=64, dims=12, strength=3), id="bush-s4-t3"),
+    pytest.param(dict(name="bush", spp=625, dims=13, strength=4), id="bush-s5-t4"),
 ]
 
 
@@ -188,6 +234,57 @@ def test_largest_cmjnd_spp(backend):
     samples, dims = [0, 1, 2**23 - 1, 2**23, 2**24 - 2, 2**24 - 1], [0, 1, 22, 23, 24, 47, 48, 49]
     got = smp.generate(pixels=[5], samples=samples, dims=dims)
     assert_same_bits(got, reference_block(smp, [5], samples, dims))
+
+
+def test_largest_gf_bose(backend):
+    """q = 256 = 2^8, spp = 65536: the largest table (GF(256), AES's modulus); a few
+    samples, the last column (j = q) and dimensions across three blocks."""
+    q = 256
+    smp = pyoa.sampler("bose", spp=q * q, dims=2 * (q + 1) + 3, seed=U32_MAX, backend=backend)
+    assert (smp.s, smp.block_dims) == (q, q + 1)
+    samples, dims = [0, 1, q, q * q - q, q * q - 1], [0, 1, 2, 3, q - 1, q, q + 1, q + 2, 2 * (q + 1), smp.dims - 1]
+    for offset in OFFSETS:
+        smp = pyoa.sampler("bose", spp=q * q, dims=2 * (q + 1) + 3, seed=U32_MAX, offset=offset, backend=backend)
+        got = smp.generate(pixels=[0, U32_MAX], samples=samples, dims=dims)
+        assert_same_bits(got, reference_block(smp, [0, U32_MAX], samples, dims), offset)
+
+
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 4), (5, 5), (7, 7), (8, 8), (16, 6), (64, 4), (256, 3),
+                                  (251, 3), (4093, 2), (256, 2)])
+def test_largest_bush(backend, s, t):
+    """The largest strength at each s (t = s), the counts N = 2^24 (8^8, 16^6, 64^4,
+    256^3), the largest prime s: few samples, including the last one and the
+    last column j = s, and dimensions past the block."""
+    N = s**t
+    smp = pyoa.sampler("bush", spp=N, dims=2 * (s + 1) + 1, strength=t, seed=0, offset="mj", backend=backend)
+    assert (smp.s, smp.strength, smp.block_dims, smp.params.M) == (s, t, s + 1, N // s)
+    samples = sorted({0, 1, s - 1, s, N // s, N // 2, N - s, N - 1})
+    dims = sorted({0, 1, s - 1, s, s + 1, 2 * s + 1, 2 * (s + 1), smp.dims - 1})
+    for seed, offset in [(0, "mj"), (U32_MAX, "cmj"), (5, "j"), (6, "centered")]:
+        smp = pyoa.sampler("bush", spp=N, dims=2 * (s + 1) + 1, strength=t, seed=seed, offset=offset, backend=backend)
+        got = smp.generate(pixels=[1, U32_MAX], samples=samples, dims=dims)
+        assert_same_bits(got, reference_block(smp, [1, U32_MAX], samples, dims), f"seed={seed} {offset}")
+
+
+@pytest.mark.parametrize("s, t", [(4, 3), (9, 2), (8, 3), (16, 2)])
+@pytest.mark.parametrize("offset", ["cmj", "centered"])
+def test_bush_table_and_direct_paths_agree(backend, s, t, offset, monkeypatch):
+    """All samples of a few pixels (the table path) and the same values one sample
+    at a time (the direct path) are the same bits, and match the reference."""
+    from pyoa.request import Request
+
+    N = s**t
+    smp = pyoa.sampler("bush", spp=N, dims=2 * (s + 1), strength=t, seed=99, offset=offset, backend=backend)
+    pixels = [0, 7, U32_MAX]
+    req = smp._request(pixels, None, None)
+    assert req.tables_pay_off(0, req.n_rows)
+    tabled = smp.generate(pixels=pixels)
+    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
+    direct = smp.generate(pixels=pixels)
+    assert_same_bits(tabled, direct, "table path vs direct path")
+    rng = np.random.default_rng(N)
+    samples = sorted({0, N - 1, *map(int, rng.integers(0, N, 12))})
+    assert_same_bits(tabled[:, samples], reference_block(smp, pixels, samples, range(smp.dims)), "vs reference")
 
 
 @pytest.mark.parametrize("s", [2, 7, 4096, 2**24])
@@ -236,7 +333,8 @@ def test_jitter_amounts(backend, jitter):
     assert_same_bits(got, reference_block(smp, [0, 3], range(25), range(7)))
 
 
-@pytest.mark.parametrize("name, spp, strength", [("bose", 121, None), ("cmjnd", 64, 3), ("cmjnd", 10, 1)])
+@pytest.mark.parametrize("name, spp, strength", [("bose", 121, None), ("cmjnd", 64, 3), ("cmjnd", 10, 1),
+                                                 ("bose", 64, None), ("bush", 125, 3), ("bush", 256, 4)])
 def test_value_equals_generate(backend, name, spp, strength):
     smp = pyoa.sampler(name, spp=spp, dims=9, strength=strength, seed=77, backend=backend, offset="j")
     x = smp.generate(pixels=[0, 12345, U32_MAX])

@@ -17,7 +17,9 @@ from tests.helpers import U32_MAX, assert_same_bits, reference_block
 
 
 @pytest.fixture(params=[pytest.param(("bose", 49, 11, None), id="bose"),
-                        pytest.param(("cmjnd", 64, 7, 3), id="cmjnd")])
+                        pytest.param(("cmjnd", 64, 7, 3), id="cmjnd"),
+                        pytest.param(("bush", 64, 11, 3), id="bush"),
+                        pytest.param(("bose", 64, 11, None), id="bose-gf8")])
 def smp(request, backend):
     name, spp, dims, strength = request.param
     return pyoa.sampler(name, spp=spp, dims=dims, strength=strength, seed=123, backend=backend)
@@ -85,9 +87,84 @@ def test_cmjnd_strength_choice(spp, dims, strength, want):
     assert s.block_dims == s.strength
 
 
+@pytest.mark.parametrize("spp, dims, strength, want", [
+    (64, 8, None, (4, 3)),    # the largest t <= dims with spp = s^t and s >= t
+    (64, 2, None, (8, 2)),
+    (64, 5, 2, (8, 2)),
+    (16, 8, None, (4, 2)),    # 2^4: s = 2 < t = 4
+    (81, 8, None, (9, 2)),    # 3^4: s = 3 < t = 4; 9 = 3^2 is a prime power
+    (256, 8, None, (4, 4)),
+    (27, 5, None, (3, 3)),
+    (27, 2, 3, (3, 3)),       # explicit strength may exceed dims
+    (9, 1, None, (3, 2)),
+    (3125, 5, None, (5, 5)),
+    (2**24, 30, None, (8, 8)),
+    (2**24, 7, None, (16, 6)),
+    (2**24, 5, None, (64, 4)),
+    (2**24, 3, None, (256, 3)),
+    (2**24, 8, 4, (64, 4)),
+    (4093**2, 4, None, (4093, 2)),
+    (256**2, 2, None, (256, 2)),
+    (17**4, 4, None, (17, 4)),  # 83521 = 289^2: strength 4 over GF(17), not GF(289)
+])
+def test_bush_strength_choice(spp, dims, strength, want):
+    s = pyoa.sampler("bush", spp=spp, dims=dims, strength=strength, backend="numpy")
+    assert (s.s, s.strength) == want
+    assert s.block_dims == s.s + 1 and s.params.M == spp // s.s
+    assert s.params.M == s.s ** (s.strength - 1)
+
+
+def test_bush_attributes_and_repr(backend):
+    s = pyoa.sampler("bush", spp=125, dims=20, seed=3, offset="mj", backend=backend)
+    assert (s.name, s.spp, s.dims, s.s, s.strength, s.block_dims) == ("bush", 125, 20, 5, 3, 6)
+    r = repr(s)
+    for part in ("'bush'", "spp=125", "s=5", "strength=3", "block_dims=6"):
+        assert part in r, (part, r)
+    assert s.generate(pixels=[0, 1]).shape == (2, 125, 20)
+
+
+@pytest.mark.parametrize("strength", [9, 12, 24])
+def test_bush_impossible_strength_names_valid_counts(strength):
+    """Bush needs s >= t and s^t <= 2^24, so strength 9..24 (accepted by the range
+    check) has no valid count at all. The error must still be useful: name the
+    nearest valid counts or say which strengths exist, not an empty "nearest: ;"."""
+    with pytest.raises(ValueError) as info:
+        pyoa.sampler("bush", spp=1000, dims=4, strength=strength, backend="numpy")
+    msg = str(info.value)
+    assert "nearest: ;" not in msg and not msg.rstrip().endswith("nearest:"), msg
+    assert re.search(r"\d+ \(s=\d+", msg) or re.search(r"\b8\b", msg), msg
+
+
+def test_valid_spp_bush_and_gf_bose():
+    from pyoa import gf
+
+    bush = pyoa.valid_spp("bush")
+    assert bush[:4] == [pyoa.SppChoice(4, 2, 2, 3), pyoa.SppChoice(9, 3, 2, 4), pyoa.SppChoice(16, 4, 2, 5),
+                        pyoa.SppChoice(25, 5, 2, 6)]
+    assert [c.spp for c in bush] == sorted(c.spp for c in bush)
+    assert len(set(bush)) == len(bush)
+    assert all(c.s**c.strength == c.spp and c.s >= c.strength and gf.is_supported(c.s) and c.block_dims == c.s + 1
+               and c.spp <= 2**24 for c in bush)
+    # independent enumeration
+    want = sorted(pyoa.SppChoice(s**t, s, t, s + 1) for t in range(2, 25) for s in range(t, 4097)
+                  if s**t <= 2**24 and gf.is_supported(s))
+    assert bush == want
+    assert {c.strength for c in bush} == set(range(2, 9))
+    assert [c for c in bush if c.spp == 2**24] == [pyoa.SppChoice(2**24, s, t, s + 1)
+                                                 for s, t in [(8, 8), (16, 6), (64, 4), (256, 3)]]
+    assert [c.s for c in pyoa.valid_spp("bush", strength=5)] == [5, 7, 8, 9, 11, 13, 16, 17, 19, 23, 25, 27]
+    assert pyoa.valid_spp("bush", strength=8) == [pyoa.SppChoice(2**24, 8, 8, 9)]
+    assert [c.label() for c in pyoa.valid_spp("bush", near=8, strength=3)] == ["27 (s=3, t=3)", "64 (s=4, t=3)"]
+    assert [c.label() for c in pyoa.valid_spp("bush", near=100)] == ["81 (s=9)", "121 (s=11)"]
+    bose = {c.s for c in pyoa.valid_spp("bose")}
+    assert {4, 8, 9, 16, 25, 27, 32, 49, 64, 81, 121, 125, 128, 169, 243, 256} <= bose
+    assert not bose & {6, 10, 12, 289, 343, 512, 625, 729, 1024, 2048, 4096}
+    assert all(gf.is_supported(s) for s in bose)
+
+
 def test_samplers_listing():
     names = pyoa.samplers()
-    assert set(names) == {"bose", "bush", "cmjnd"}
+    assert set(names) == {"bose", "bush", "cmjnd", "addelman-kempthorne", "bose-bush"}
     assert all(isinstance(v, str) and v for v in names.values())
 
 
@@ -261,7 +338,31 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="bose", spp=121.0), TypeError, ["spp", "integer"]),
     (dict(name="bose", spp="121"), TypeError, ["spp"]),
     (dict(name="bose", spp=True), TypeError, ["spp"]),
-    (dict(name="bose", spp=121, strength=3), ValueError, ["strength", "cmjnd"]),
+    (dict(name="bose", spp=121, strength=3), ValueError, ["strength", "cmjnd", "bush"]),
+    # Bose over GF(q): s must be a prime or a prime power <= 256
+    (dict(name="bose", spp=36), ValueError, ["36", "prime power", "25 (s=5)", "49 (s=7)", "valid for", "cmjnd (s=6)"]),
+    (dict(name="bose", spp=289**2), ValueError, ["83521", "256", "80089 (s=283)", "85849 (s=293)",
+                                                 "valid for", "bush (s=17, t=4)",
+                                                 "cmjnd (s=17, t=4)"]),
+    (dict(name="bose", spp=512**2), ValueError, ["262144", "253009 (s=503)", "259081 (s=509)", "bush (s=64, t=3)"]),
+    (dict(name="bose", spp=4096**2), ValueError, ["16736281 (s=4091)", "16752649 (s=4093)", "bush (s=64, t=4)"]),
+    # Bush: s a prime power, t <= s
+    (dict(name="bush", spp=8, strength=3), ValueError, ["8", "s^3", "s >= t", "27 (s=3, t=3)", "64 (s=4, t=3)",
+                                                        "valid for", "cmjnd (s=2, t=3)"]),
+    (dict(name="bush", spp=16, strength=4), ValueError, ["16", "s^4", "256 (s=4, t=4)", "625 (s=5, t=4)",
+                                                         "valid for", "bose (s=4)", "cmjnd (s=2, t=4)"]),
+    (dict(name="bush", spp=36), ValueError, ["36", "prime power", "25 (s=5)", "27 (s=3, t=3)", "cmjnd (s=6)"]),
+    (dict(name="bush", spp=216, strength=3), ValueError, ["216", "125 (s=5, t=3)", "343 (s=7, t=3)",
+                                                          "cmjnd (s=6, t=3)"]),
+    (dict(name="bush", spp=289**2, strength=2), ValueError, ["83521", "s^2", "80089 (s=283)", "85849 (s=293)"]),
+    (dict(name="bush", spp=1000, dims=3), ValueError, ["1000", "2 <= t <= 3", "961 (s=31)", "1024 (s=32)",
+                                                       "cmjnd (s=10, t=3)"]),
+    (dict(name="bush", spp=1), ValueError, ["4 (s=2)", "9 (s=3)"]),
+    (dict(name="bush", spp=64, strength=1), ValueError, ["strength", "2"]),
+    (dict(name="bush", spp=64, strength=25), ValueError, ["strength", "25"]),
+    (dict(name="bush", spp=64, strength=0), ValueError, ["strength"]),
+    (dict(name="bush", spp=64, strength=3.0), TypeError, ["strength"]),
+    (dict(name="bush", spp=2**25), ValueError, ["spp", "16777216"]),
     (dict(name="bose", spp=121, strength=1), ValueError, ["strength 2"]),
     (dict(name="cmjnd", spp=1000, dims=2), ValueError, ["1000", "961 (s=31)", "1024 (s=32)"]),
     (dict(name="cmjnd", spp=100, dims=8, strength=3), ValueError, ["100", "s^3", "64 (s=4, t=3)", "125 (s=5, t=3)"]),

@@ -61,6 +61,8 @@ class NumpyBackend:
             "bose": lambda: oa.bose_cell(i, col, s),
             "bush": lambda: oa.bush_cell(i, col, s, prm.strength),
             "cmjnd": lambda: oa.cmjnd_cell(i, col, s),
+            "addelman-kempthorne": lambda: oa.addelman_kempthorne_cell(i, col, s),
+            "bose-bush": lambda: oa.bose_bush_cell(i, col, s),
         }[req.construction.name]()
         if req.offset == "cmj":
             subs = permute(np.arange(M, dtype=U32), M, (q * U32(SUBSTRATUM_KEY))[..., None])

@@ -129,3 +129,58 @@ def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> n
     stratum = permute(aij, s, q * U32(STRATUM_KEY))
     sub = offset_sub(offset, u, M, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
     return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)
+
+
+def addelman_kempthorne_cell(i, col, q: int):
+    """``(A_ij, u)`` of Addelman-Kempthorne column ``col < 2q+1`` (see the reference)."""
+    i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
+    F = Field(q)
+    Q = U32(q)
+    kappa, b, k, c = (np.asarray(v, dtype=U32) for v in gf.ak_constants(q))
+    h, x, y = i // (Q * Q), (i // Q) % Q, i % Q
+    x2 = F.mul(x, x)
+    hq = h * Q
+    # Columns 1..q-1 use multiplier m = col; q..2q-1 use m = col - q (m = 0
+    # is column q, since k[0] = c[0] = 0). Out-of-range m are clamped to 0 to
+    # keep table indices valid; np.where discards those lanes.
+    mA = np.where((col >= 1) & (col < Q), col, U32(0))
+    mB = np.where((col >= Q) & (col < 2 * Q), col - Q, U32(0))
+    colA = F.add(F.add(x, F.mul(mA, y)), np.where(h == 1, b[mA], U32(0)))
+    colB = np.where(
+        h == 1,
+        F.add(F.add(F.add(y, F.mul(k[mB], x)), F.mul(kappa, x2)), c[mB]),
+        F.add(F.add(y, F.mul(mB, x)), x2),
+    )
+    aij = np.where(col == 0, y, np.where(col < Q, colA, np.where(col < 2 * Q, colB, x)))
+    u = hq + np.where((col == 0) | ((col >= Q) & (col < 2 * Q)), x, y)
+    return aij, u
+
+
+def bose_bush_cell(i, col, s: int):
+    """``(A_ij, u)`` of Bose-Bush column ``col < 2s+1``, computed in GF(2s)."""
+    i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
+    F = Field(2 * s)
+    S = U32(s)
+    x, k = i // S, i % S
+    a = (F.mul(x, np.minimum(col, U32(2 * s - 1))) % S) ^ k
+    last = col == U32(2 * s)
+    return np.where(last, x % S, a), np.where(last, (x // S) * S + k, x)
+
+
+def _index2(cell, i, j, s: int, p, offset: str, jitter: float) -> np.ndarray:
+    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
+    q = column_key(p, j, 2 * s + 1)
+    aij, u = cell(i, j % U32(2 * s + 1), s)
+    stratum = permute(aij, s, q * U32(STRATUM_KEY))
+    sub = offset_sub(offset, u, 2 * s, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
+    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), 2 * s, s, jitter)
+
+
+def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.addelman_kempthorne` (parameters assumed valid)."""
+    return _index2(addelman_kempthorne_cell, i, j, q, p, offset, jitter)
+
+
+def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.bose_bush` (parameters assumed valid)."""
+    return _index2(bose_bush_cell, i, j, s, p, offset, jitter)

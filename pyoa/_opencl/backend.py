@@ -39,11 +39,25 @@ class OpenCLBackend:
         # their arguments are set under self._lock.
         self._kernels = {k.function_name: k for k in self.program.all_kernels()}
         self._fields: dict[int, tuple] = {}
+        self._consts: dict[tuple, object] = {}
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
 
     def describe(self) -> str:
         return self.info.describe()
+
+    def _constants(self, req: Request):
+        """Buffer of the construction's constants (Addelman-Kempthorne's), uploaded
+        once per (construction, s); a 1-element placeholder when there are none.
+        Called with self._lock held."""
+        key = (req.construction.name, req.params.s)
+        if key not in self._consts:
+            import pyopencl as cl
+
+            values = np.array(req.construction.constants(req.params) or [0], dtype=np.uint32)
+            self._consts[key] = cl.Buffer(self.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR,
+                                          hostbuf=values)
+        return self._consts[key]
 
     def _field(self, q: int) -> tuple:
         """Kernel arguments ``(gf buffer, tabled)`` for GF(q), uploaded once per q.
@@ -77,7 +91,7 @@ class OpenCLBackend:
             # Only the pixels of these rows travel to the device.
             pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
             pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
-            gf_args = self._field(prm.s if req.construction.uses_field else 0)
+            gf_args = (*self._field(req.construction.field_order(prm)), self._constants(req))
             if req.tables_pay_off(row0, row1):
                 E = req.table_entries
                 n_entries = (pix1 - pix0) * req.n_dims * E

@@ -8,6 +8,6 @@ Public functions: :func:`permute`, :func:`randfloat`, :func:`pixel_seed`,
 """
 
 from .hashes import block_seed, dimension_seeds, mix32, permute, pixel_seed, randfloat
-from .oa import bose, bush, cmjnd
+from .oa import addelman_kempthorne, bose, bose_bush, bush, cmjnd
 
-__all__ = ["permute", "randfloat", "pixel_seed", "block_seed", "dimension_seeds", "mix32", "bose", "bush", "cmjnd"]
+__all__ = ["permute", "randfloat", "pixel_seed", "block_seed", "dimension_seeds", "mix32", "bose", "bush", "cmjnd", "addelman_kempthorne", "bose_bush"]

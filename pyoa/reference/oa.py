@@ -217,3 +217,123 @@ def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: fl
     else:  # cmj
         sub = permute(u, M, P2)
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
+
+
+def _index2_sub(offset: str, u: int, M: int, i: int, aij: int, P2: int) -> float:
+    """Sub-stratum of the index-2 constructions (``M = 2s`` points per stratum)."""
+    if offset == "centered":
+        return _centered(M)
+    if offset == "j":
+        return permute(u, M, ((i + 1) * P2) & MASK)
+    if offset == "mj":
+        return permute(u, M, ((aij + 1) * P2) & MASK)
+    return permute(u, M, P2)  # cmj
+
+
+def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
+    """Addelman-Kempthorne OA sample: strength 2, index 2, ``q`` an odd prime
+    power, ``N = 2 q**2``, ``2q + 1`` columns per block.
+
+    Row ``i = h q**2 + x q + y`` (half ``h``, ``x, y`` in GF(q)); with the
+    constants ``kappa, b, k, c`` of :func:`pyoa.gf.ak_constants`:
+
+    ============  =======================  ==================================
+    column        first half (h = 0)       second half (h = 1)
+    ============  =======================  ==================================
+    0             y                        y
+    m = 1..q-1    x + m y                  x + m y + b[m]
+    q             y + x**2                 y + kappa x**2
+    q + m         y + m x + x**2           y + k[m] x + kappa x**2 + c[m]
+    2q            x                        x
+    ============  =======================  ==================================
+
+    All ``2q + 1`` columns, the full standard set (the last one adds a few
+    triple coincidences between rows but keeps strength 2).
+
+    Sub-strata (``M = 2q``): in columns 1..q-1 and 2q a stratum fixes ``x``
+    given ``y`` and ``h``, so ``u = h q + y``; in columns 0 and q..2q-1 it
+    fixes ``y``, so ``u = h q + x``. Either takes every value in ``[0, 2q)``
+    once per stratum, so ``mj`` and ``cmj`` are 1D Latin hypercubes.
+
+    References
+    ----------
+    .. [1] S. Addelman and O. Kempthorne, "Some main-effect plans and
+       orthogonal arrays of strength two", Ann. Math. Statist. 32(4), 1961.
+    .. [2] A. S. Hedayat, N. J. A. Sloane, J. Stufken, "Orthogonal Arrays",
+       Springer, 1999, section 3.4.
+    """
+    pr = gf.prime_power(q)
+    if pr is None or pr[0] == 2 or not gf.is_supported(q):
+        raise ValueError(f"addelman-kempthorne needs q an odd prime, or odd prime power <= {gf.MAX_TABLE_Q}, got {q}")
+    N = 2 * q * q
+    J = _check_common(i, N, j, p, offset, jitter)
+    block, j = divmod(j, 2 * q + 1)
+    p = block_seed(p, block)
+    P1, P2, P3 = dimension_seeds(p, j)
+
+    kappa, b, k, c = gf.ak_constants(q)
+    h, x, y = i // (q * q), (i // q) % q, i % q
+    add, mul = (lambda a, b_: gf.add(a, b_, q)), (lambda a, b_: gf.mul(a, b_, q))
+    x2 = mul(x, x)
+    if j == 0:
+        aij, u = y, h * q + x
+    elif j < q:
+        aij, u = add(add(x, mul(j, y)), b[j] if h else 0), h * q + y
+    elif j == q:
+        aij, u = add(y, mul(kappa, x2) if h else x2), h * q + x
+    elif j < 2 * q:
+        m = j - q
+        if h:
+            aij = add(add(add(y, mul(k[m], x)), mul(kappa, x2)), c[m])
+        else:
+            aij = add(add(y, mul(m, x)), x2)
+        u = h * q + x
+    else:
+        aij, u = x, h * q + y
+
+    M = 2 * q
+    stratum = permute(aij, q, P1)
+    sub = _index2_sub(offset, u, M, i, aij, P2)
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, q)
+
+
+def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
+    """Bose-Bush OA sample: strength 2, index 2, ``s = 2**r``, ``N = 2 s**2``,
+    ``2s + 1`` columns per block.
+
+    Computed in GF(2s) (elements are bit patterns, addition is XOR). Row
+    ``i = x s + k`` with ``x`` in GF(2s) and ``k < s``; column ``j < 2s`` is
+    ``low_r(x * j) XOR k`` (the low ``r`` bits of the field product), and
+    column ``2s`` is ``x mod s``.
+
+    Sub-strata (``M = 2s``): in a column ``j < 2s`` a stratum fixes ``k`` given
+    ``x``, so ``u = x``; in column ``2s`` it fixes ``x mod s``, so
+    ``u = (x // s) s + k``. Both take every value in ``[0, 2s)`` once per
+    stratum: ``mj`` and ``cmj`` are 1D Latin hypercubes (the authors' version
+    offered jittered offsets only).
+
+    References
+    ----------
+    .. [1] R. C. Bose and K. A. Bush, "Orthogonal arrays of strength two and
+       three", Ann. Math. Statist. 23(4), 1952.
+    .. [2] A. S. Hedayat, N. J. A. Sloane, J. Stufken, "Orthogonal Arrays",
+       Springer, 1999, section 3.5.
+    """
+    if s < 2 or s & (s - 1) or 2 * s > gf.MAX_TABLE_Q:
+        raise ValueError(f"bose-bush needs s a power of two with 2 <= s <= {gf.MAX_TABLE_Q // 2}, got {s}")
+    N = 2 * s * s
+    J = _check_common(i, N, j, p, offset, jitter)
+    block, j = divmod(j, 2 * s + 1)
+    p = block_seed(p, block)
+    P1, P2, P3 = dimension_seeds(p, j)
+
+    x, k = i // s, i % s
+    if j < 2 * s:
+        aij, u = (gf.mul(x, j, 2 * s) % s) ^ k, x
+    else:
+        aij, u = x % s, (x // s) * s + k
+
+    M = 2 * s
+    stratum = permute(aij, s, P1)
+    sub = _index2_sub(offset, u, M, i, aij, P2)
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)

@@ -53,3 +53,49 @@ def test_c_oracle_agrees_on_seed_zero(spec_c):
         want = np.array(spec_c.bose_bits(rows), dtype=np.uint32).view(np.float32).reshape(25, 9)
         got = noa.bose(np.arange(25, dtype=U32)[:, None], np.arange(9, dtype=U32)[None, :], 5, U32(0), off, 1.0)
         assert_same_bits(got, want, off)
+
+
+# ----------------------------------------------------------------------------- Bose over GF(q), Bush
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+@pytest.mark.parametrize("p", [0, 1, U32_MAX])
+@pytest.mark.parametrize("q", [4, 9, 8])
+def test_gf_bose_equals_reference_including_seed_zero(q, p, offset):
+    i = np.arange(q * q, dtype=U32)[:, None]
+    j = np.arange(2 * (q + 1) + 1, dtype=U32)[None, :]
+    got = noa.bose(i, j, q, U32(p), offset, 0.3)
+    want = np.array([[ref.bose(a, b, q, p, offset, 0.3) for b in range(j.size)] for a in range(i.size)], np.float32)
+    assert_same_bits(got, want, f"bose q={q} p={p} {offset}")
+
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+@pytest.mark.parametrize("p", [0, 0xDEADBEEF])
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 3), (5, 2), (8, 2), (9, 2)])
+def test_bush_equals_reference_including_seed_zero(s, t, p, offset):
+    i = np.arange(s**t, dtype=U32)[:, None]
+    j = np.arange(2 * (s + 1) + 1, dtype=U32)[None, :]
+    got = noa.bush(i, j, s, t, U32(p), offset, 0.75)
+    want = np.array([[ref.bush(a, b, s, t, p, offset, 0.75) for b in range(j.size)] for a in range(i.size)],
+                    np.float32)
+    assert_same_bits(got, want, f"bush s={s} t={t} p={p} {offset}")
+
+
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 4), (5, 5), (8, 3), (9, 2), (27, 2), (256, 2)])
+def test_bush_cell_is_the_polynomial_array(s, t):
+    """bush_cell over whole columns, against the independent plain array and the
+    documented sub-stratum index (u = i // s, column s: i mod s^(t-1))."""
+    from tests.helpers import plain_bush_array
+
+    N, M = s**t, s ** (t - 1)
+    rows = np.arange(N) if N <= 4096 else np.random.default_rng(s).integers(0, N, 4096)
+    A = plain_bush_array(s, t)[rows] if N <= 4096 else None
+    i = rows.astype(U32)[:, None]
+    col = np.arange(s + 1, dtype=U32)[None, :]
+    aij, u = noa.bush_cell(i, col, s, t)
+    if A is not None:
+        assert np.array_equal(aij, A)
+    assert np.array_equal(u[:, :s], np.broadcast_to(i // U32(s), (len(rows), s)))
+    assert np.array_equal(u[:, s], rows % M)
+    assert np.array_equal(aij[:, s], rows // M)
+    assert np.array_equal(aij[:, 0], rows % s)  # f(0) = c_0
+    assert aij.max() < s and u.max() < M

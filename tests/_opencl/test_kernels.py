@@ -39,6 +39,20 @@ __kernel void t_bose(__global const uint *i, __global const uint *j, const uint 
 __kernel void t_cmjnd(__global const uint *i, __global const uint *j, const uint s, const uint t,
                       __global const uint *p, const uint offset, const float J, __global float *out)
 { size_t g = get_global_id(0); out[g] = cmjnd(i[g], j[g], s, t, p[g], offset, J); }
+
+__kernel void t_gf(__global const uint *a, __global const uint *b, const uint q, __global const ushort *gf,
+                   const uint tabled, __global uint *sum, __global uint *prod)
+{ size_t g = get_global_id(0); sum[g] = gf_add(a[g], b[g], q, gf, tabled); prod[g] = gf_mul(a[g], b[g], q, gf, tabled); }
+
+__kernel void t_bose_gf(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
+                        const uint offset, const float J, __global const ushort *gf, const uint tabled,
+                        __global float *out)
+{ size_t g = get_global_id(0); out[g] = bose(i[g], j[g], s, p[g], offset, J, gf, tabled); }
+
+__kernel void t_bush(__global const uint *i, __global const uint *j, const uint s, const uint t,
+                     __global const uint *p, const uint offset, const float J, __global const ushort *gf,
+                     const uint tabled, __global float *out)
+{ size_t g = get_global_id(0); out[g] = bush(i[g], j[g], s, t, p[g], offset, J, gf, tabled); }
 """
 
 
@@ -163,3 +177,71 @@ def test_build_options_keep_floats_exact():
     for bad in ("-cl-fast-relaxed-math", "-cl-mad-enable", "-cl-unsafe-math-optimizations"):
         assert bad not in opts
     assert "#pragma OPENCL FP_CONTRACT OFF" in prog.source()
+
+
+# ----------------------------------------------------------------------------- GF(q), Bose over GF(q), Bush
+
+@pytest.fixture(scope="module")
+def field_args(opencl):
+    """``q -> (gf buffer, tabled)``: the kernel arguments the backend passes for GF(q)."""
+    import pyopencl as cl
+
+    from pyoa._opencl.backend import _field_tables
+
+    def args(q):
+        tab, tabled = _field_tables(q)
+        buf = cl.Buffer(opencl.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=tab)
+        return buf, U32(tabled)
+
+    return args
+
+
+@pytest.mark.parametrize("q", [4, 8, 9, 27, 125, 256, 2, 13, 251, 4093])
+def test_gf_add_mul_match_pyoa_gf(harness, field_args, q):
+    """kernels/gf.cl: table lookups for prime powers, mod q for primes, on every pair
+    (or many random ones), against pyoa.gf's scalar definition."""
+    from pyoa import gf
+
+    if q * q <= 70000:
+        a, b = (x.astype(U32) for x in np.divmod(np.arange(q * q), q))
+    else:
+        rng = np.random.default_rng(q)
+        a, b = (rng.integers(0, q, 5000).astype(U32) for _ in range(2))
+    tab, tabled = field_args(q)
+    assert bool(tabled) == (gf.prime_power(q)[1] > 1)
+    sums, prods = harness("t_gf", [U32, U32], a, b, U32(q), tab, tabled)
+    if tabled:
+        add, mul = gf.tables(q)
+        assert np.array_equal(sums, add[a * q + b]) and np.array_equal(prods, mul[a * q + b])
+    else:
+        assert np.array_equal(sums, (a.astype(np.int64) + b) % q)
+        assert np.array_equal(prods, (a.astype(np.int64) * b) % q)
+    for k in range(0, len(a), max(1, len(a) // 40)):  # spot checks against the scalar definition
+        x, y = int(a[k]), int(b[k])
+        assert sums[k] == gf.add(x, y, q) and prods[k] == gf.mul(x, y, q)
+
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+def test_gf_bose_and_bush_match_reference_including_seed_zero(harness, field_args, offset):
+    from pyoa import reference as ref
+
+    code = {"centered": 0, "j": 1, "mj": 2, "cmj": 3}[offset]
+    rng = np.random.default_rng(10 + code)
+    seeds = np.array([0, 1, U32_MAX, 0x12345678], U32)
+    for q in (4, 9, 16, 27, 256, 7):
+        n = 200
+        i = np.concatenate([[0, q * q - 1], rng.integers(0, q * q, n - 2)]).astype(U32)
+        j = np.concatenate([[q, q + 1], rng.integers(0, 3 * (q + 1), n - 2)]).astype(U32)
+        p = rng.choice(seeds, n)
+        got = harness("t_bose_gf", [np.float32], i, j, U32(q), p, U32(code), np.float32(0.625), *field_args(q))
+        want = np.array([ref.bose(int(a), int(b), q, int(c), offset, 0.625) for a, b, c in zip(i, j, p)], np.float32)
+        assert_same_bits(got, want, f"bose q={q}")
+    for s, t in ((2, 2), (3, 3), (4, 4), (5, 5), (8, 8), (9, 2), (16, 6), (256, 3), (4093, 2)):
+        n = 150 if s < 4093 else 30
+        N = s**t
+        i = np.concatenate([[0, N - 1], rng.integers(0, N, n - 2)]).astype(U32)
+        j = np.concatenate([[s, 2 * s + 1], rng.integers(0, 3 * (s + 1), n - 2)]).astype(U32)
+        p = rng.choice(seeds, n)
+        got = harness("t_bush", [np.float32], i, j, U32(s), U32(t), p, U32(code), np.float32(1.0), *field_args(s))
+        want = np.array([ref.bush(int(a), int(b), s, t, int(c), offset, 1.0) for a, b, c in zip(i, j, p)], np.float32)
+        assert_same_bits(got, want, f"bush s={s} t={t}")

@@ -17,9 +17,18 @@ import pytest
 
 import pyoa
 from pyoa import reference as ref
+from pyoa._numpy import oa as noa
+from pyoa.reference.floats import jitter_value, sample_value
 from tests.helpers import (
     OFFSET_CODE,
     U32_MAX,
+    bush_sub_index,
+    bush_symbol,
+    field_for,
+    gf_bose_partner_symbol,
+    gf_bose_symbol,
+    plain_bush_array,
+    plain_gf_bose_array,
     assert_latin_closed,
     assert_latin_exact,
     assert_oa,
@@ -169,9 +178,9 @@ def test_cmjnd_full_grid_reference(s, t):
 N_PIXELS = 48
 
 
-def _bulk(name, spp, dims, backend, offset, strength=None, seed=0):
+def _bulk(name, spp, dims, backend, offset, strength=None, seed=0, n_pixels=N_PIXELS):
     kw = dict(spp=spp, dims=dims, offset=offset, strength=strength, seed=seed, backend=backend)
-    pixels = list(range(N_PIXELS - 2)) + [U32_MAX - 1, U32_MAX]
+    pixels = list(range(n_pixels - 2)) + [U32_MAX - 1, U32_MAX]
     x0 = pyoa.sampler(name, jitter=0.0, **kw).generate(pixels=pixels)
     x1 = pyoa.sampler(name, jitter=1.0, **kw).generate(pixels=pixels)
     return x0, x1
@@ -248,6 +257,267 @@ def test_bose_cmj_is_correlated_jj_is_not(backend):
     assert functional < 8
 
 
+# ----------------------------------------------------------------------------- Bose over GF(q), Bush
+
+GF_BOSE_Q = [4, 8, 9, 16, 25, 27]
+#: (s, t) of Bush: prime and prime-power s, t from 2 up to s (N = s^t moderate)
+BUSH_ST = [(2, 2), (3, 2), (3, 3), (4, 2), (4, 3), (4, 4), (5, 4), (5, 5), (7, 3), (8, 3), (9, 2), (8, 4), (16, 2)]
+
+
+def _canonical(fn, N, d, **kw):
+    """Values of the canonical array (seed 0: identity permutations, jitter 0.5)
+    from the reference for small N, else from the NumPy functions (bit-equal to
+    the reference at seed 0: tests/_numpy/test_oa.py)."""
+    if N * d <= 6000:
+        return _ref_array(getattr(ref, fn), N, range(d), p=0, **kw)
+    i = np.arange(N, dtype=np.uint32)[:, None]
+    j = np.arange(d, dtype=np.uint32)[None, :]
+    args = (kw["s"],) if fn == "bose" else (kw["s"], kw["t"])
+    return getattr(noa, fn)(i, j, *args, np.uint32(0), kw["offset"], kw.get("jitter", 1.0))
+
+
+@pytest.mark.parametrize("q", GF_BOSE_Q)
+def test_gf_bose_canonical_array_is_the_plain_bose_array_over_gf(q):
+    """Seed 0 is A_ij = a0 + (j-1) a1 in GF(q) (codes: base-p digits, modulus of
+    KNOWN_MODULI), computed by an independent polynomial implementation; the fine
+    cell is A_ij*q + A_ik (partner column k, SPEC section 5); an OA(q^2, q+1, q, 2)."""
+    N, d = q * q, q + 1
+    A, Ak = plain_gf_bose_array(q)
+    F = field_for(q)  # spot check the vectorized array against the scalar definition
+    assert all(A[i, j] == gf_bose_symbol(i, j, F) for i in (0, 1, q + 2, N - 1) for j in range(d))
+    assert_oa(A, q, 2, what=f"plain GF({q}) Bose")
+    for offset in ("cmj", "mj", "j") if q <= 9 else ("cmj",):
+        x = _canonical("bose", N, d, s=q, offset=offset)
+        assert np.array_equal(strata_exact(x, q), A), offset
+        assert np.array_equal(np.floor(x.astype(np.float64) * N), A * q + Ak), offset
+    x = _canonical("bose", N, d, s=q, offset="centered")
+    assert_same_bits(x, ((A + 0.5) / q).astype(np.float32), "canonical centred")
+
+
+@pytest.mark.parametrize("q", [4, 8, 9, 16, 27])
+def test_integer_mod_q_is_not_an_oa_for_prime_powers(q):
+    """Why GF(q) is needed (SPEC section 5): the integer formula (a0 + (j-1) a1) mod q
+    is no OA for composite q, and the OA check above detects it."""
+    A = np.array([[bose_symbol(i, j, q) for j in range(q + 1)] for i in range(q * q)])
+    with pytest.raises(AssertionError, match="not an OA"):
+        assert_oa(A, q, 2)
+
+
+def _bose_mod_s(i, j, s, p, offset, jitter):
+    """The pre-GF Bose value (SPEC section 5, prime s), written with plain mod-s
+    integers and pyoa's hash and float primitives only."""
+    block, j = divmod(j, s + 1)
+    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    aij, aik = bose_symbol(i, j, s), bose_partner_symbol(i, j, s)
+    stratum = ref.permute(aij, s, P1)
+    if offset == "centered":
+        sub = (s - 1) / 2
+    else:
+        seed = {"j": (aik * s + aij + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
+        sub = ref.permute(aik, s, seed)
+    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), s, s)
+
+
+@pytest.mark.parametrize("s", [2, 3, 5, 7, 13, 31, 251, 257, 4093])
+def test_prime_bose_is_unchanged_by_gf(s):
+    """For prime s the GF code path gives the bits of the integer formula."""
+    rng = np.random.default_rng(s)
+    for k in range(150 if s < 1000 else 25):
+        i, j = int(rng.integers(0, s * s)), int(rng.integers(0, 3 * (s + 1)))
+        if k < 4:
+            i, j = [(0, 0), (s * s - 1, s), (s * s - 1, s + 1), (s, s - 1)][k]
+        p = int(rng.choice([0, 1, U32_MAX])) if k % 5 == 0 else int(rng.integers(0, 2**32))
+        offset, J = OFFSETS[k % 4], [1.0, 0.0, 0.4375][k % 3]
+        want = _bose_mod_s(i, j, s, p, offset, J)
+        got = ref.bose(i, j, s, p, offset, J)
+        assert np.float32(got).view(np.uint32) == np.float32(want).view(np.uint32), (i, j, s, p, offset, J)
+
+
+def _gf_bose_from_spec(i, j, q, p, offset, jitter):
+    """SPEC section 5 "Bose over GF(q)", with the independent field of tests.helpers."""
+    F = field_for(q)
+    block, j = divmod(j, q + 1)
+    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    aij, aik = gf_bose_symbol(i, j, F), gf_bose_partner_symbol(i, j, F)
+    stratum = ref.permute(aij, q, P1)
+    if offset == "centered":
+        sub = (q - 1) / 2
+    else:
+        seed = {"j": (aik * q + aij + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
+        sub = ref.permute(aik, q, seed)
+    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), q, q)
+
+
+def _bush_from_spec(i, j, s, t, p, offset, jitter):
+    """SPEC section 5 "Bush" (with pyoa's documented u = i mod M in column s),
+    with the independent field of tests.helpers."""
+    F = field_for(s)
+    M = s ** (t - 1)
+    block, j = divmod(j, s + 1)
+    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    aij, u = bush_symbol(i, j, t, F), bush_sub_index(i, j, s, t)
+    stratum = ref.permute(aij, s, P1)
+    if offset == "centered":
+        sub = (M - 1) / 2
+    else:
+        seed = {"j": (i + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
+        sub = ref.permute(u, M, seed)
+    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), M, s)
+
+
+def _same_f32(a, b):
+    return np.float32(a).view(np.uint32) == np.float32(b).view(np.uint32)
+
+
+@pytest.mark.parametrize("q", [4, 8, 9, 16, 25, 27, 49, 256])
+def test_gf_bose_reference_follows_spec(q):
+    """Whole values (permutations, offsets, jitter, blocks) of reference.bose over
+    GF(q) against SPEC section 5 written out with an independent GF(q)."""
+    rng = np.random.default_rng(q)
+    for k in range(120):
+        i, j = int(rng.integers(0, q * q)), int(rng.integers(0, 3 * (q + 1)))
+        if k < 3:
+            i, j = [(q * q - 1, q), (q * q - 1, q + 1), (0, 2 * q + 1)][k]
+        p = int(rng.choice([0, 1, U32_MAX])) if k % 4 == 0 else int(rng.integers(0, 2**32))
+        offset, J = OFFSETS[k % 4], [1.0, 0.0, 0.8125][k % 3]
+        assert _same_f32(ref.bose(i, j, q, p, offset, J), _gf_bose_from_spec(i, j, q, p, offset, J)), \
+            (i, j, q, p, offset, J)
+
+
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 4), (5, 5), (7, 3), (8, 8), (9, 2), (16, 6), (27, 3),
+                                  (256, 3), (4093, 2)])
+def test_bush_reference_follows_spec(s, t):
+    """Whole values of reference.bush against SPEC section 5 (Bush) written out
+    with an independent GF(s), including column s, blocks and edge seeds."""
+    rng = np.random.default_rng(s * 100 + t)
+    N = s**t
+    for k in range(100 if s < 4093 else 12):
+        i, j = int(rng.integers(0, N)), int(rng.integers(0, 3 * (s + 1)))
+        if k < 4:
+            i, j = [(N - 1, s), (N - 1, s + 1), (0, 2 * s + 1), (N // 2, s)][k]
+        p = int(rng.choice([0, 1, U32_MAX])) if k % 4 == 0 else int(rng.integers(0, 2**32))
+        offset, J = OFFSETS[k % 4], [1.0, 0.0, 0.8125][k % 3]
+        assert _same_f32(ref.bush(i, j, s, t, p, offset, J), _bush_from_spec(i, j, s, t, p, offset, J)), \
+            (i, j, s, t, p, offset, J)
+
+
+@pytest.mark.parametrize("s, t", BUSH_ST)
+def test_bush_canonical_array_is_the_polynomial_array(s, t):
+    """Seed 0: column j < s is the row polynomial (base-s digits of i, c_0 least
+    significant) at x = j in GF(s), column s its leading coefficient, recomputed
+    by an independent GF(s); every t of the s+1 columns is a full grid (index 1).
+    The fine cell is A_ij*M + u with u = i // s in columns j < s and u = i mod M in
+    column s (pyoa's documented deviation from SPEC, reference.oa.bush)."""
+    F = field_for(s)
+    N, M, d = s**t, s ** (t - 1), s + 1
+    A = plain_bush_array(s, t)
+    rng = np.random.default_rng(N)
+    for i in [0, 1, N - 1] + [int(v) for v in rng.integers(0, N, 30)]:  # vectorized == scalar definition
+        assert [bush_symbol(i, j, t, F) for j in range(d)] == A[i].tolist(), i
+    U = np.array([[bush_sub_index(i, j, s, t) for j in range(d)] for i in range(N)])
+    assert_oa(A, s, t, what=f"plain Bush s={s} t={t}")
+    for offset in ("cmj", "mj", "j") if N * d <= 6000 else ("cmj",):
+        x = _canonical("bush", N, d, s=s, t=t, offset=offset)
+        assert np.array_equal(strata_exact(x, s), A), offset
+        assert np.array_equal(np.floor(x.astype(np.float64) * N), A * M + U), offset
+        assert_latin_exact(x, N, f"canonical Bush s={s} t={t} {offset}")
+    x = _canonical("bush", N, d, s=s, t=t, offset="centered")
+    assert_same_bits(x, ((A + 0.5) / s).astype(np.float32), "canonical centred")
+
+
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 3), (5, 4)])
+def test_bush_last_column_needs_the_deviation(s, t):
+    """SPEC's literal u = i // s in column s repeats sub-strata within a stratum
+    (i // s contains the stratum digit c_{t-1}), so it would not be a Latin
+    hypercube; u = i mod s^(t-1) is, and every other column keeps SPEC's u."""
+    N, M = s**t, s ** (t - 1)
+    lead = np.arange(N) // M
+    spec_cells = lead * M + np.arange(N) // s
+    assert len(np.unique(spec_cells)) < N
+    pyoa_cells = lead * M + np.arange(N) % M
+    assert np.array_equal(np.sort(pyoa_cells), np.arange(N))
+    x = np.array([ref.bush(i, s, s, t, 0, "cmj", 0.0) for i in range(N)], np.float32)
+    assert np.array_equal(np.floor(x.astype(np.float64) * N), pyoa_cells)
+    x = np.array([ref.bush(i, 0, s, t, 0, "cmj", 0.0) for i in range(N)], np.float32)
+    assert np.array_equal(np.floor(x.astype(np.float64) * N) % M, np.arange(N) // s)
+
+
+@pytest.mark.parametrize("q", [4, 8, 9])
+def test_gf_bose_oa_reference(q):
+    N, d = q * q, q + 1
+    plain = plain_gf_bose_array(q)[0]
+    for p in (1, U32_MAX):
+        for offset in OFFSETS:
+            x0 = _ref_array(ref.bose, N, range(d), s=q, p=p, offset=offset, jitter=0.0)
+            x1 = _ref_array(ref.bose, N, range(d), s=q, p=p, offset=offset, jitter=1.0)
+            check_array(x0, x1, q, 2, N, [range(d)], offset, f"bose q={q} p={p} {offset}")
+            assert not np.array_equal(strata_exact(x0, q), plain)
+
+
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 2), (4, 3), (5, 2)])
+def test_bush_oa_reference(s, t):
+    N, d = s**t, s + 1
+    plain = plain_bush_array(s, t)
+    for p in (1, 0xC0FFEE, U32_MAX):
+        for offset in OFFSETS:
+            x0 = _ref_array(ref.bush, N, range(d), s=s, t=t, p=p, offset=offset, jitter=0.0)
+            x1 = _ref_array(ref.bush, N, range(d), s=s, t=t, p=p, offset=offset, jitter=1.0)
+            check_array(x0, x1, s, t, N, [range(d)], offset, f"bush s={s} t={t} p={p} {offset}")
+            if s >= 3:
+                assert not np.array_equal(strata_exact(x0, s), plain)
+
+
+def _pixels_for(N):
+    """Enough independently randomized arrays, fewer for larger N (run time)."""
+    return int(min(48, max(6, 20000 // N)))
+
+
+@pytest.mark.parametrize("offset", OFFSETS)
+@pytest.mark.parametrize("q", GF_BOSE_Q)
+def test_gf_bose_oa_bulk(backend, q, offset):
+    """Many seeds (pixels), both backends: every pair of the q+1 columns of each
+    block is a full q x q grid, mj/cmj are Latin hypercubes at q^2 cells in every
+    column, and block 1 is a differently randomized valid copy."""
+    d = q + 1
+    dims = 2 * d + 2
+    seed = {"centered": 0, "j": 7, "mj": 0xDEADBEEF, "cmj": U32_MAX}[offset]
+    x0, x1 = _bulk("bose", q * q, dims, backend, offset, seed=seed, n_pixels=_pixels_for(q * q))
+    check_blocks(x0, x1, q, 2, q * q, d, 2, offset, f"bose q={q} {offset} seed={seed} [{backend}]")
+    assert_oa(strata_exact(x0, q), q, 2, cols=range(2 * d, dims))
+
+
+@pytest.mark.parametrize("offset", OFFSETS)
+@pytest.mark.parametrize("s, t", BUSH_ST)
+def test_bush_oa_bulk(backend, s, t, offset):
+    """Every t-subset of ALL s+1 columns (column s included) of each block holds
+    every t-tuple exactly once; mj/cmj give a Latin hypercube at N cells in every
+    column; blocks past the first are differently randomized valid copies (the
+    partial third block: its t columns are a full grid too)."""
+    N, d = s**t, s + 1
+    dims = 2 * d + t
+    seed = {"centered": 0, "j": 7, "mj": 0xDEADBEEF, "cmj": U32_MAX}[offset]
+    x0, x1 = _bulk("bush", N, dims, backend, offset, strength=t, seed=seed, n_pixels=_pixels_for(N))
+    check_blocks(x0, x1, s, t, N, d, 2, offset, f"bush s={s} t={t} {offset} [{backend}]")
+    assert_oa(strata_exact(x0, s), s, t, cols=range(2 * d, dims))
+    # each pixel's array is randomized, not the canonical one
+    plain = plain_bush_array(s, t)
+    if s >= 3:
+        assert not (strata_exact(x0[..., :d], s) == plain).all(axis=(-2, -1)).any()
+
+
+@pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 4), (9, 2), (16, 3), (32, 2), (49, 2), (64, 2), (11, 3)])
+def test_bush_latin_many_seeds(backend, s, t):
+    """mj and cmj: 1D Latin hypercube at N cells in every column, column s included,
+    over many seeds (pixels x user seeds)."""
+    N, d = s**t, s + 1
+    for offset in ("mj", "cmj"):
+        for seed in (1, 2**31, U32_MAX):
+            x = pyoa.sampler("bush", spp=N, dims=d, strength=t, seed=seed, offset=offset, jitter=0.0,
+                             backend=backend).generate(pixels=range(max(4, 20000 // N)))
+            assert_latin_exact(x, N, f"bush s={s} t={t} {offset} seed={seed}")
+            assert_oa(strata_exact(x, s), s, t, cols=range(d) if d <= 6 else [0, 1, s - 1, s])
+
+
 # ----------------------------------------------------------------------------- unbiasedness (SPEC 8.6)
 
 def _f_cos(x):
@@ -270,7 +540,8 @@ def _f_step(x):
 @pytest.mark.parametrize(
     "name, spp, dims, strength, offset",
     [("bose", 49, 11, None, "cmj"), ("bose", 121, 5, None, "j"), ("cmjnd", 64, 7, 3, "cmj"),
-     ("cmjnd", 81, 6, 2, "mj"), ("bose", 25, 4, None, "mj"), ("cmjnd", 9, 3, 1, "j")],
+     ("cmjnd", 81, 6, 2, "mj"), ("bose", 25, 4, None, "mj"), ("cmjnd", 9, 3, 1, "j"),
+     ("bose", 64, 11, None, "cmj"), ("bush", 64, 7, 3, "cmj"), ("bush", 81, 5, 2, "mj"), ("bush", 256, 6, 4, "j")],
 )
 def test_estimates_are_unbiased(backend, name, spp, dims, strength, offset):
     """Mean over pixels (independent arrays) of the per-pixel estimate is within 5
@@ -305,3 +576,33 @@ def test_centered_offset_is_not_uniform():
     x = pyoa.sampler("bose", spp=25, dims=3, offset="centered", backend="numpy").generate(pixels=range(50))
     frac = (x.astype(np.float64) * s) % 1
     assert frac.min() >= 0.4 - 1e-6 and frac.max() <= 0.6 + 1e-6
+
+
+# ----------------------------------------------------------------------------- reference parameter checks
+
+@pytest.mark.parametrize("s", [1, 6, 12, 289, 512, 4096])
+def test_reference_bose_refuses_unsupported_s(s):
+    with pytest.raises(ValueError, match=f"prime power.*s={s}"):
+        ref.bose(0, 0, s, 0)
+
+
+@pytest.mark.parametrize("s, t", [(2, 3), (3, 4), (4, 5), (4, 1), (5, 0), (6, 2), (10, 3), (289, 2), (512, 2)])
+def test_reference_bush_refuses_bad_s_or_t(s, t):
+    with pytest.raises(ValueError, match=f"s={s}, t={t}"):
+        ref.bush(0, 0, s, t, 0)
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(i=64), ["[0, 64)", "64"]), (dict(i=-1), ["[0, 64)"]), (dict(j=-1), ["dimension"]),
+    (dict(p=2**32), ["seed"]), (dict(p=-1), ["seed"]), (dict(offset="cj"), ["offset", "'cj'"]),
+    (dict(jitter=1.5), ["jitter"]), (dict(jitter=float("nan")), ["jitter"]),
+])
+def test_reference_bush_refuses_bad_arguments(kw, words):
+    args = {"i": 0, "j": 0, "s": 4, "t": 3, "p": 0, "offset": "cmj", "jitter": 1.0, **kw}
+    with pytest.raises(ValueError) as info:
+        ref.bush(**args)
+    for w in words:
+        assert w in str(info.value)
+    if "i" not in kw and "j" not in kw:
+        with pytest.raises(ValueError):
+            ref.bose(**{k: v for k, v in args.items() if k != "t"})
