@@ -107,6 +107,10 @@ CASES: dict[str, dict] = {
                             about="Bush s=5 t=3, correlated multi-jittered offsets"),
     "bush-gf-cmj-256x10": dict(name="bush", spp=256, dims=10, offset="cmj", strength=4,
                                about="Bush over GF(4) (s=4, t=4), correlated multi-jittered offsets"),
+    "ak-cmj-98x10": dict(name="addelman-kempthorne", spp=98, dims=10, offset="cmj", strength=None,
+                         about="Addelman-Kempthorne q=7 (index 2), correlated multi-jittered offsets"),
+    "bosebush-cmj-128x10": dict(name="bose-bush", spp=128, dims=10, offset="cmj", strength=None,
+                                about="Bose-Bush s=8 in GF(16) (index 2), correlated multi-jittered offsets"),
 }
 REQUIRED_CASE = "bose-cmj-121x10"
 #: The full set of cases takes about 8 minutes on a 2-core machine (NumPy
