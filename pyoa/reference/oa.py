@@ -47,6 +47,18 @@ def _centered(M: int) -> float:
     return (M - 1) / 2
 
 
+def _offset_sub(offset: str, u: int, M: int, cell_key: int, aij: int, P2: int) -> float:
+    """The sub-stratum of SPEC section 4: ``u`` (the point's index inside its
+    coarse stratum, in ``[0, M)``) permuted with a seed per cell (``j``:
+    ``cell_key * P2``), per stratum (``mj``: ``(A_ij + 1) * P2``) or per
+    column (``cmj``: ``P2``); ``centered`` is ``(M - 1) / 2``. ``cell_key`` is
+    ``A_ik s + A_ij + 1`` for Bose and ``i + 1`` for the other constructions."""
+    if offset == "centered":
+        return _centered(M)
+    seed = {"j": cell_key * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset]
+    return permute(u, M, seed & MASK)
+
+
 def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
     """Bose OA sample, strength 2: ``s`` a prime power, ``N = s**2``, ``s + 1`` columns per block.
 
@@ -90,14 +102,7 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
         aik = gf.add(a0, gf.mul((k - 1) % s, a1, s), s)
 
     stratum = permute(aij, s, P1)
-    if offset == "centered":
-        sub = _centered(s)
-    elif offset == "j":
-        sub = permute(aik, s, ((aik * s + aij + 1) * P2) & MASK)
-    elif offset == "mj":
-        sub = permute(aik, s, ((aij + 1) * P2) & MASK)
-    else:  # cmj
-        sub = permute(aik, s, P2)
+    sub = _offset_sub(offset, aik, s, aik * s + aij + 1, aij, P2)
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), s, s)
 
 
@@ -138,14 +143,7 @@ def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: f
     v = i % sj + (i // (sj * s)) * sj
 
     stratum = permute(aij, s, P1)
-    if offset == "centered":
-        sub = _centered(M)
-    elif offset == "j":
-        sub = permute(v, M, ((i + 1) * P2) & MASK)
-    elif offset == "mj":
-        sub = permute(v, M, ((aij + 1) * P2) & MASK)
-    else:  # cmj
-        sub = permute(v, M, P2)
+    sub = _offset_sub(offset, v, M, i + 1, aij, P2)
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
 
 
@@ -208,26 +206,8 @@ def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: fl
         u = i % M
 
     stratum = permute(aij, s, P1)
-    if offset == "centered":
-        sub = _centered(M)
-    elif offset == "j":
-        sub = permute(u, M, ((i + 1) * P2) & MASK)
-    elif offset == "mj":
-        sub = permute(u, M, ((aij + 1) * P2) & MASK)
-    else:  # cmj
-        sub = permute(u, M, P2)
+    sub = _offset_sub(offset, u, M, i + 1, aij, P2)
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
-
-
-def _index2_sub(offset: str, u: int, M: int, i: int, aij: int, P2: int) -> float:
-    """Sub-stratum of the index-2 constructions (``M = 2s`` points per stratum)."""
-    if offset == "centered":
-        return _centered(M)
-    if offset == "j":
-        return permute(u, M, ((i + 1) * P2) & MASK)
-    if offset == "mj":
-        return permute(u, M, ((aij + 1) * P2) & MASK)
-    return permute(u, M, P2)  # cmj
 
 
 def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -293,7 +273,7 @@ def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jit
 
     M = 2 * q
     stratum = permute(aij, q, P1)
-    sub = _index2_sub(offset, u, M, i, aij, P2)
+    sub = _offset_sub(offset, u, M, i + 1, aij, P2)
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, q)
 
 
@@ -335,5 +315,5 @@ def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float
 
     M = 2 * s
     stratum = permute(aij, s, P1)
-    sub = _index2_sub(offset, u, M, i, aij, P2)
+    sub = _offset_sub(offset, u, M, i + 1, aij, P2)
     return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
