@@ -66,8 +66,10 @@ def cmd_points(args) -> int:
 
 
 def cmd_samplers(args) -> int:
-    for name, desc in samplers().items():
-        print(f"{name:8s} {desc}")
+    names = samplers()
+    width = max(map(len, names))
+    for name, desc in names.items():
+        print(f"{name:{width}s}  {desc}")
     return 0
 
 
