@@ -175,9 +175,10 @@ def ak_constants(q: int) -> tuple[int, tuple[int, ...], tuple[int, ...], tuple[i
     (1961) as tabulated in Hedayat, Sloane and Stufken, "Orthogonal Arrays"
     (1999), section 3.4.
     """
-    p, _ = prime_power(q)
-    if p == 2:
-        raise ValueError(f"Addelman-Kempthorne needs q odd, got {q}")
+    pr = prime_power(q)
+    if pr is None or pr[0] == 2:
+        raise ValueError(f"Addelman-Kempthorne needs q an odd prime power, got {q}")
+    p = pr[0]
     squares = {mul(x, x, q) for x in range(q)}
     kappa = next(x for x in range(1, q) if x not in squares)
     four = 4 % p  # the field element 4 = 1 + 1 + 1 + 1 (1 when p = 3)

@@ -102,6 +102,10 @@ def reference_block(smp, pixels, samples, dims) -> np.ndarray:
                     out[a, b, c] = ref.bush(int(i), int(j), smp.s, smp.strength, p, smp.offset, smp.jitter)
                 elif smp.name == "cmjnd":
                     out[a, b, c] = ref.cmjnd(int(i), int(j), smp.s, smp.strength, p, smp.offset, smp.jitter)
+                elif smp.name == "addelman-kempthorne":
+                    out[a, b, c] = ref.addelman_kempthorne(int(i), int(j), smp.s, p, smp.offset, smp.jitter)
+                elif smp.name == "bose-bush":
+                    out[a, b, c] = ref.bose_bush(int(i), int(j), smp.s, p, smp.offset, smp.jitter)
                 else:  # a new construction must be added here, not silently compared to another one
                     raise AssertionError(f"reference_block does not know sampler {smp.name!r}")
     return out
@@ -352,6 +356,165 @@ def bush_sub_index(i: int, j: int, s: int, t: int) -> int:
     """The sub-stratum index u of pyoa's Bush (reference.oa.bush): i // s in
     columns j < s, i mod s**(t-1) in column s (the documented deviation from SPEC)."""
     return i % s ** (t - 1) if j == s else i // s
+
+
+# --------------------------------------------------------------------------- index-2 arrays (AK, Bose-Bush)
+
+#: Addelman-Kempthorne q (odd prime powers) and Bose-Bush s (powers of two) of the
+#: property tests; every 2s+1 columns of the arrays are checked pair by pair.
+AK_Q = [3, 5, 7, 9, 11, 13, 25, 27]
+BB_S = [2, 4, 8, 16, 32]
+
+
+def index2_levels(name: str) -> list[int]:
+    """Every s of an index-2 sampler, enumerated independently of pyoa.constructions:
+    Addelman-Kempthorne q odd, a prime or a prime power <= 256, 2q^2 <= 2^24;
+    Bose-Bush s = 2^r with 2s <= 256 (GF(2s) tables)."""
+    if name == "bose-bush":
+        return [2**r for r in range(1, 8)]
+    out = []
+    for q in range(3, 2**12, 2):
+        pr = factor_prime_power(q)
+        if pr and 2 * q * q <= 2**24 and (pr[1] == 1 or q <= 256):
+            out.append(q)
+    return out
+
+
+@functools.lru_cache(maxsize=None)
+def field_inverses(q: int) -> tuple[int, ...]:
+    """``inv[a]`` (``inv[0] = 0``) in :func:`field_for` GF(q), from the powers of a
+    primitive element (``inv(g^e) = g^(q-1-e)``): no Fermat exponentiation, no tables
+    of pyoa.gf."""
+    F = field_for(q)
+    for g in range(2, q) if q > 2 else [1]:
+        powers, x = [1], g
+        while x != 1:
+            powers.append(x)
+            x = F.mul(x, g)
+        if len(powers) == q - 1:
+            break
+    else:  # pragma: no cover - every finite field has a primitive element
+        raise AssertionError(f"no primitive element of GF({q})")
+    inv = [0] * q
+    for e, a in enumerate(powers):
+        inv[a] = powers[(q - 1 - e) % (q - 1)]
+    return tuple(inv)
+
+
+@functools.lru_cache(maxsize=None)
+def ak_constants_independent(q: int, kappa: int | None = None) -> tuple[int, tuple, tuple, tuple]:
+    """``(kappa, b, k, c)`` of Addelman-Kempthorne (1961) / Hedayat-Sloane-Stufken 3.4
+    as pyoa documents them (kappa the smallest non-square by code; b[m] =
+    (kappa-1)/(4 kappa m), k[m] = kappa m, c[m] = m^2 (kappa-1)/4, index 0 unused = 0),
+    computed with :class:`PolyField`: 4 = 1+1+1+1, -1 found by search, inverses
+    from :func:`field_inverses`. ``kappa`` given: the same formulas with that
+    element instead (for tests that need another, or a wrong, kappa)."""
+    F = field_for(q)
+    if kappa is None:
+        squares = {F.mul(x, x) for x in range(q)}
+        kappa = min(x for x in range(q) if x not in squares)
+    four = F.add(F.add(F.add(1, 1), 1), 1)
+    minus_one = next(e for e in range(q) if F.add(e, 1) == 0)
+    num = F.add(kappa, minus_one)  # kappa - 1
+    inv = field_inverses(q)
+    b, k, c = [0] * q, [0] * q, [0] * q
+    for m in range(1, q):
+        b[m] = F.mul(num, inv[F.mul(F.mul(four, kappa), m)])
+        k[m] = F.mul(kappa, m)
+        c[m] = F.mul(F.mul(F.mul(m, m), num), inv[four])
+    return kappa, tuple(b), tuple(k), tuple(c)
+
+
+def ak_symbol(i: int, j: int, q: int) -> tuple[int, int]:
+    """``(A_ij, u)`` of the plain Addelman-Kempthorne array, column ``j < 2q+1``,
+    written from the table of reference.addelman_kempthorne's docstring with the
+    independent field: row ``i = h q^2 + x q + y``; ``u = h q + x`` in the columns
+    where a stratum fixes y (0 and q..2q-1), ``u = h q + y`` in the others."""
+    F = field_for(q)
+    kappa, b, k, c = ak_constants_independent(q)
+    h, rest = divmod(i, q * q)
+    x, y = divmod(rest, q)
+    x2 = F.mul(x, x)
+    if j == 0:
+        a = y
+    elif j < q:  # x + m y (+ b_m)
+        a = F.add(x, F.mul(j, y))
+        if h:
+            a = F.add(a, b[j])
+    elif j < 2 * q:  # y + m x + x^2, or y + k_m x + kappa x^2 + c_m (m = 0: column q, k_0 = c_0 = 0)
+        m = j - q
+        if h:
+            a = F.add(F.add(F.add(y, F.mul(k[m], x)), F.mul(kappa, x2)), c[m])
+        else:
+            a = F.add(F.add(y, F.mul(m, x)), x2)
+    else:
+        a = x
+    u = h * q + (x if j == 0 or q <= j < 2 * q else y)
+    return a, u
+
+
+@functools.lru_cache(maxsize=None)
+def plain_ak_array(q: int, kappa: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, U)``, each (2q^2, 2q+1): :func:`ak_symbol` over the whole array,
+    vectorized over :func:`field_tables` (independent of pyoa.gf); read-only, cached.
+    ``kappa``: see :func:`ak_constants_independent`."""
+    add, mul = field_tables(q)
+    kappa, b, k, c = (np.asarray(v) for v in ak_constants_independent(q, kappa))
+    i = np.arange(2 * q * q)
+    h, x, y = i // (q * q), (i // q) % q, i % q
+    x2 = mul[x, x]
+    A = np.empty((2 * q * q, 2 * q + 1), dtype=np.int64)
+    U = np.empty_like(A)
+    A[:, 0], U[:, 0] = y, h * q + x
+    for m in range(1, q):
+        A[:, m] = add[add[x, mul[m, y]], np.where(h == 1, b[m], 0)]
+        U[:, m] = h * q + y
+    for m in range(q):
+        first = add[add[y, mul[m, x]], x2]
+        second = add[add[add[y, mul[k[m], x]], mul[kappa, x2]], c[m]]
+        A[:, q + m] = np.where(h == 1, second, first)
+        U[:, q + m] = h * q + x
+    A[:, 2 * q], U[:, 2 * q] = x, h * q + y
+    A.flags.writeable = U.flags.writeable = False
+    return A, U
+
+
+def bose_bush_symbol(i: int, j: int, s: int) -> tuple[int, int]:
+    """``(A_ij, u)`` of the plain Bose-Bush array (Bose and Bush 1952, HSS 3.5),
+    column ``j < 2s+1``: in GF(2s) (independent field), the low r bits of x*j (the
+    class of the product modulo the additive subgroup of multiples of x^r) plus k,
+    for row ``i = x s + k``; column 2s is the class x mod s of x. ``u = x``, and in
+    column 2s ``u = (x // s) s + k``."""
+    F = field_for(2 * s)
+    x, k = divmod(i, s)
+    if j < 2 * s:
+        return F.add(F.mul(x, j) % s, k), x
+    return x % s, (x // s) * s + k
+
+
+@functools.lru_cache(maxsize=None)
+def plain_bose_bush_array(s: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, U)``, each (2s^2, 2s+1), of :func:`bose_bush_symbol`, vectorized over
+    :func:`field_tables` of GF(2s); read-only, cached."""
+    add, mul = field_tables(2 * s)
+    i = np.arange(2 * s * s)
+    x, k = i // s, i % s
+    A = np.empty((2 * s * s, 2 * s + 1), dtype=np.int64)
+    U = np.empty_like(A)
+    for j in range(2 * s):
+        A[:, j] = add[mul[x, j] % s, k]
+        U[:, j] = x
+    A[:, 2 * s], U[:, 2 * s] = x % s, (x // s) * s + k
+    A.flags.writeable = U.flags.writeable = False
+    return A, U
+
+
+def plain_index2_array(name: str, s: int) -> tuple[np.ndarray, np.ndarray]:
+    return plain_ak_array(s) if name == "addelman-kempthorne" else plain_bose_bush_array(s)
+
+
+def index2_symbol(name: str, i: int, j: int, s: int) -> tuple[int, int]:
+    return ak_symbol(i, j, s) if name == "addelman-kempthorne" else bose_bush_symbol(i, j, s)
 
 
 # --------------------------------------------------------------------------- OA / LH checks

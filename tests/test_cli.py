@@ -247,3 +247,53 @@ def test_cli_bush_and_gf_bose_listing_and_errors(tmp_path, capsys):
                             "--out", tmp_path / "x.npy"], capsys)
     assert code == 2 and "27 (s=3, t=3)" in err and "64 (s=4, t=3)" in err
     assert not (tmp_path / "x.npy").exists()
+
+
+# ----------------------------------------------------------------------------- index 2 from the CLI
+
+@pytest.mark.parametrize("name, spp, dims, offset", [("bose-bush", 32, 20, "mj"), ("addelman-kempthorne", 50, 13, "cmj")])
+def test_points_index2_equals_api(tmp_path, capsys, backend, name, spp, dims, offset):
+    """`pyoa points --sampler bose-bush --spp 32 ...` (and Addelman-Kempthorne): the
+    .npy is the API's array bit for bit, dimensions past the block included; the
+    CSV round-trips to the same bits."""
+    out = tmp_path / "x.npy"
+    args = ["points", "--sampler", name, "--spp", spp, "--dims", dims, "--pixels", "3", "--pixel0", "4294967293",
+            "--seed", "4294967295", "--offset", offset, "--jitter", "0.75", "--backend", backend]
+    code, stdout, _ = run_cli(args + ["--out", out, "-q"], capsys)
+    assert code == 0 and stdout == ""
+    want = pyoa.sampler(name, spp=spp, dims=dims, seed=2**32 - 1, offset=offset, jitter=0.75,
+                        backend=backend).generate(pixels=range(4294967293, 4294967296))
+    x = np.load(out)
+    assert x.shape == (3, spp, dims) and x.dtype == np.float32
+    assert_same_bits(x, want)
+    code, stdout, _ = run_cli(args + ["--out", tmp_path / "x.csv"], capsys)
+    assert code == 0 and f"Sampler('{name}'" in stdout and f"{3 * spp * dims:,} values" in stdout
+    with open(tmp_path / "x.csv", newline="") as fh:
+        rows = list(csv.reader(fh))[1:]
+    vals = np.array([[float(v) for v in r[2:]] for r in rows]).astype(np.float32).reshape(3, spp, dims)
+    assert_same_bits(vals, want)
+
+
+def test_cli_index2_listing_and_errors(tmp_path, capsys):
+    code, out, _ = run_cli(["samplers"], capsys)
+    assert code == 0 and "\naddelman-kempthorne " in out and "\nbose-bush " in out
+    code, out, _ = run_cli(["spp", "bose-bush"], capsys)
+    assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == \
+        [[str(2 * s * s), str(s), "2", str(2 * s + 1)] for s in (2, 4, 8, 16, 32, 64, 128)]
+    code, out, _ = run_cli(["spp", "addelman-kempthorne", "--near", "100"], capsys)
+    assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == [["50", "5", "2", "11"],
+                                                                                   ["98", "7", "2", "15"]]
+    code, out, _ = run_cli(["spp", "addelman-kempthorne", "--limit", "3"], capsys)
+    assert code == 0 and "18 " in out and "... 423 more" in out
+    code, _, err = run_cli(["points", "--sampler", "addelman-kempthorne", "--spp", "32", "--out", tmp_path / "x.npy"],
+                           capsys)
+    # with the default 8 dims, 32 = 2^5 is a cmjnd count too
+    assert code == 2 and "18 (s=3)" in err and "50 (s=5)" in err
+    assert "32 is valid for cmjnd (s=2, t=5), bose-bush (s=4)" in err
+    assert "Traceback" not in err
+    code, _, err = run_cli(["points", "--sampler", "bose-bush", "--spp", "18", "--out", tmp_path / "x.npy"], capsys)
+    assert code == 2 and "8 (s=2)" in err and "valid for addelman-kempthorne (s=3)" in err
+    code, _, err = run_cli(["points", "--sampler", "bose-bush", "--spp", "32", "--strength", "3",
+                            "--out", tmp_path / "x.npy"], capsys)
+    assert code == 2 and "strength 2 only" in err
+    assert os.listdir(tmp_path) == []

@@ -15,12 +15,15 @@ from pyoa import reference as ref
 from pyoa._numpy import hashes as nh
 from pyoa import gf
 from tests.helpers import (
+    AK_Q,
+    BB_S,
     BOSE_PRIMES,
     GF_POWERS,
     PIXEL_KEY,
     U32_MAX,
     assert_same_bits,
     bits,
+    index2_levels,
     reference_block,
 )
 
@@ -50,12 +53,26 @@ def bush_s(t: int) -> list[int]:
 
 
 BUSH_S = {t: bush_s(t) for t in range(2, 9)}
+INDEX2 = ("addelman-kempthorne", "bose-bush")
+AK_LEVELS = index2_levels("addelman-kempthorne")  # 3 .. 2887
+BB_LEVELS = index2_levels("bose-bush")  # 2 .. 128
+
+
+def spp_of(name: str, s: int, t: int) -> int:
+    return 2 * s * s if name in INDEX2 else s**t
 
 
 @st.composite
 def configs(draw):
-    name = draw(st.sampled_from(["bose", "bush", "cmjnd"]))
-    if name == "bose":
+    name = draw(st.sampled_from(["bose", "bush", "cmjnd", *INDEX2]))
+    if name == "addelman-kempthorne":
+        # small q, any q (prime up to 2887, odd prime power up to 243), the largest of each kind
+        s = draw(st.sampled_from(AK_Q) | st.sampled_from(AK_LEVELS) | st.sampled_from([243, 2887]))
+        t, spp, block = 2, 2 * s * s, 2 * s + 1
+    elif name == "bose-bush":
+        s = draw(st.sampled_from(BB_S) | st.sampled_from(BB_LEVELS))
+        t, spp, block = 2, 2 * s * s, 2 * s + 1
+    elif name == "bose":
         s = draw(st.sampled_from(SMALL_BOSE) | st.sampled_from(SMALL_GF) | st.sampled_from(GF_POWERS)
                  | st.sampled_from(BOSE_PRIMES))
         t, spp, block = 2, s * s, s + 1
@@ -101,11 +118,13 @@ def make_sampler(cfg, backend):
     smp = pyoa.sampler(cfg["name"], spp=cfg["spp"], dims=cfg["dims"], seed=cfg["seed"], offset=cfg["offset"],
                        jitter=cfg["jitter"], strength=cfg["t"] if cfg["name"] != "bose" else None, backend=backend)
     assert (smp.s, smp.strength) == (cfg["s"], cfg["t"])
+    if cfg["name"] in INDEX2:
+        assert (smp.block_dims, smp.params.M) == (2 * cfg["s"] + 1, 2 * cfg["s"])
     return smp
 
 
 def _cfg(name, s, t, dims, seed, offset, jitter, pixels, samples, dim_idx):
-    return dict(name=name, s=s, t=t, spp=s**t, dims=dims, seed=seed, offset=offset, jitter=jitter,
+    return dict(name=name, s=s, t=t, spp=spp_of(name, s, t), dims=dims, seed=seed, offset=offset, jitter=jitter,
                 pixels=pixels, samples=samples, dim_idx=dim_idx)
 
 
@@ -132,6 +151,28 @@ def _cfg(name, s, t, dims, seed, offset, jitter, pixels, samples, dim_idx):
 @example(cfg=_cfg("bush", 256, 3, 258, 3, "cmj", 1.0, [0], [0, 65536, 2**24 - 1], [0, 1, 255, 256, 257]))
 @example(cfg=_cfg("bush", 4093, 2, 4095, 1, "mj", 1.0, [4], [0, 4093, 4093**2 - 1], [0, 4092, 4093, 4094]))
 @example(cfg=_cfg("bush", 27, 3, 30, 11, "cmj", 0.75, [1, 2], list(range(19683 - 900, 19683)), [0, 26, 27, 28, 29]))
+# Addelman-Kempthorne: the largest q = 2887 (a prime: no tables), few samples, the
+# last sample and last column j = 2q, the first columns of blocks 1 and 2
+@example(cfg=_cfg("addelman-kempthorne", 2887, 2, 2 * 5775 + 2, U32_MAX, "cmj", 1.0, [0, U32_MAX],
+                  [0, 1, 2887**2 - 1, 2887**2, 2 * 2887**2 - 1],
+                  [0, 1, 2886, 2887, 2888, 5773, 5774, 5775, 2 * 5775, 2 * 5775 + 1]))
+@example(cfg=_cfg("addelman-kempthorne", 2887, 2, 5776, 0, "mj", 0.5, [zero_hash_pixel(0)], [2 * 2887**2 - 1],
+                  [5774, 5775]))
+# the largest GF-table q = 243 = 3^5, enough samples for the table path (E = 3q + 1 = 730
+# per pixel and dimension), across both halves of the array
+@example(cfg=_cfg("addelman-kempthorne", 243, 2, 2 * 487 + 1, 0, "cmj", 1.0, [3],
+                  list(range(243**2 - 400, 243**2 + 400)), [0, 1, 242, 243, 244, 485, 486, 487, 974]))
+@example(cfg=_cfg("addelman-kempthorne", 243, 2, 490, U32_MAX, "j", 0.25, [U32_MAX], [0, 2 * 243**2 - 1],
+                  [0, 242, 243, 486, 487, 489]))
+@example(cfg=_cfg("addelman-kempthorne", 3, 2, 15, 0, "centered", 0.0, [0], list(range(17, -1, -1)),
+                  [0, 2, 3, 5, 6, 7, 13, 14]))
+@example(cfg=_cfg("addelman-kempthorne", 9, 2, 40, 1, "mj", 1.0, [1, 2], list(range(162)), [0, 8, 9, 17, 18, 19, 39]))
+# Bose-Bush: the largest s = 128 (GF(256), spp 32768): table path (E = 385) and the last column j = 2s
+@example(cfg=_cfg("bose-bush", 128, 2, 2 * 257 + 1, U32_MAX, "cmj", 1.0, [U32_MAX],
+                  list(range(32768 - 400, 32768)), [0, 1, 127, 128, 255, 256, 257, 513, 514]))
+@example(cfg=_cfg("bose-bush", 128, 2, 260, 0, "mj", 1.0, [7], [0, 127, 128, 16384, 32767], [0, 255, 256, 257, 259]))
+@example(cfg=_cfg("bose-bush", 2, 2, 11, U32_MAX, "centered", 1.0, [5], list(range(8)), [0, 3, 4, 5, 9, 10]))
+@example(cfg=_cfg("bose-bush", 4, 2, 20, 0, "j", 0.0, [zero_hash_pixel(0), 0], list(range(32)), [0, 7, 8, 9, 17, 19]))
 def test_backend_matches_reference(backend, cfg):
     smp = make_sampler(cfg, backend)
     assert smp.backend == backend
@@ -163,7 +204,9 @@ def test_opencl_matches_numpy_in_bulk(cfg, n_pixels):
 @pytest.mark.parametrize("name, spp, strength", [("bose", 49, None), ("cmjnd", 27, 3), ("cmjnd", 16, 2),
                                                  ("bose", 961, None), ("cmjnd", 256, 4),
                                                  ("bose", 64, None), ("bose", 729, None), ("bush", 64, 3),
-                                                 ("bush", 81, 2), ("bush", 625, 4), ("bush", 27, 3)])
+                                                 ("bush", 81, 2), ("bush", 625, 4), ("bush", 27, 3),
+                                                 ("addelman-kempthorne", 50, None), ("addelman-kempthorne", 162, 2),
+                                                 ("bose-bush", 32, None), ("bose-bush", 128, 2)])
 def test_table_path_threshold(backend, name, spp, strength, offset):
     """Both backends switch to precomputed permutation tables for `cmj` and
     `centered` once the samples per pixel reach the table size (s, plus M for
@@ -183,6 +226,9 @@ def test_table_path_threshold(backend, name, spp, strength, offset):
     ("bose", 81, None, [0, 5, 9, 10, 13]),     # GF(9)
     ("bush", 125, 3, [0, 5, 6, 11, 13]),       # last column j = s, and past the block
     ("bush", 256, 4, [0, 3, 4, 5, 13]),        # GF(4), t = s
+    ("addelman-kempthorne", 50, None, [0, 4, 5, 10, 11, 13]),  # q = 5: the last column is 10, then block 1
+    ("addelman-kempthorne", 162, None, [0, 8, 9, 13]),         # GF(9), both halves of the array
+    ("bose-bush", 32, None, [0, 3, 4, 7, 8, 9, 13]),           # GF(8): the last column j = 2s = 8
 ])
 def test_table_path_with_chunks(monkeypatch, backend, name, spp, strength, check_dims):
     import pyoa._numpy.backend as nb
@@ -203,6 +249,9 @@ SAMPLER_CASES = [
     pytest.param(dict(name="bose", spp=81, dims=21, strength=None), id="bose-gf9"),
     pytest.param(dict(name="bush", spp=64, dims=12, strength=3), id="bush-s4-t3"),
     pytest.param(dict(name="bush", spp=625, dims=13, strength=4), id="bush-s5-t4"),
+    pytest.param(dict(name="addelman-kempthorne", spp=50, dims=25, strength=None), id="ak-q5"),
+    pytest.param(dict(name="addelman-kempthorne", spp=2 * 27**2, dims=60, strength=2), id="ak-gf27"),
+    pytest.param(dict(name="bose-bush", spp=32, dims=20, strength=None), id="bb-s4"),
 ]
 
 
@@ -334,7 +383,8 @@ def test_jitter_amounts(backend, jitter):
 
 
 @pytest.mark.parametrize("name, spp, strength", [("bose", 121, None), ("cmjnd", 64, 3), ("cmjnd", 10, 1),
-                                                 ("bose", 64, None), ("bush", 125, 3), ("bush", 256, 4)])
+                                                 ("bose", 64, None), ("bush", 125, 3), ("bush", 256, 4),
+                                                 ("addelman-kempthorne", 18, None), ("bose-bush", 8, None)])
 def test_value_equals_generate(backend, name, spp, strength):
     smp = pyoa.sampler(name, spp=spp, dims=9, strength=strength, seed=77, backend=backend, offset="j")
     x = smp.generate(pixels=[0, 12345, U32_MAX])
@@ -344,6 +394,77 @@ def test_value_equals_generate(backend, name, spp, strength):
                 v = smp.value(pix, i, j)
                 assert isinstance(v, float)
                 assert np.float32(v).view(np.uint32) == x[a, i, j].view(np.uint32)
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", 2887), ("addelman-kempthorne", 243),
+                                     ("addelman-kempthorne", 251), ("addelman-kempthorne", 3),
+                                     ("bose-bush", 128), ("bose-bush", 2)])
+def test_largest_and_smallest_index2(backend, name, s):
+    """The index-2 extremes: Addelman-Kempthorne q = 2887 (spp = 2 * 2887^2, the
+    largest; prime arithmetic, no tables), q = 243 (the largest GF table), q = 251
+    (the largest prime with tables skipped), q = 3; Bose-Bush s = 128 (GF(256),
+    spp 32768) and s = 2 (GF(4)). Few samples (both halves of the array, the last
+    one), the last column j = 2s and dimensions across three blocks, every offset
+    and edge seeds."""
+    N, d = 2 * s * s, 2 * s + 1
+    samples = sorted({0, 1, s - 1, s, s * s - 1, s * s, s * s + s, N - s, N - 1})
+    dims = sorted({0, 1, s - 1, s, s + 1, 2 * s - 1, 2 * s, d, d + 1, 2 * d - 1, 2 * d, 2 * d + 2})
+    for seed, offset, jitter in [(0, "mj", 1.0), (U32_MAX, "cmj", 1.0), (5, "j", 0.5), (6, "centered", 0.0)]:
+        smp = pyoa.sampler(name, spp=N, dims=2 * d + 3, seed=seed, offset=offset, jitter=jitter, backend=backend)
+        assert (smp.s, smp.strength, smp.block_dims, smp.params.M) == (s, 2, d, 2 * s)
+        got = smp.generate(pixels=[1, U32_MAX], samples=samples, dims=dims)
+        assert_same_bits(got, reference_block(smp, [1, U32_MAX], samples, dims), f"seed={seed} {offset}")
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", 2887), ("addelman-kempthorne", 243),
+                                     ("addelman-kempthorne", 251), ("bose-bush", 128)])
+@pytest.mark.parametrize("offset", ["cmj", "centered"])
+def test_index2_table_path_at_the_largest_sizes(backend, name, s, offset, monkeypatch):
+    """The table path at the largest orders: one pixel, E = s (+ 2s for cmj) + 1
+    consecutive samples and a few more (the least that pays off), across the two
+    halves of the array for Addelman-Kempthorne or ending at the last sample; the
+    last column j = 2s and dimensions past the block. Same bits as the direct
+    path, and as the reference on a subset."""
+    from pyoa.request import Request
+
+    N, d = 2 * s * s, 2 * s + 1
+    smp = pyoa.sampler(name, spp=N, dims=2 * d + 1, seed=12, offset=offset, backend=backend)
+    n = smp._request([0], [0], None).table_entries + 3
+    start = s * s - n // 2 if name == "addelman-kempthorne" else N - n
+    samples = range(start, start + n)
+    dims = [0, 1, s - 1, s, 2 * s - 1, 2 * s, d, 2 * d]
+    assert smp._request([U32_MAX], samples, dims).tables_pay_off(0, n)
+    tabled = smp.generate(pixels=[U32_MAX], samples=samples, dims=dims)
+    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
+    assert_same_bits(tabled, smp.generate(pixels=[U32_MAX], samples=samples, dims=dims), "table vs direct path")
+    rng = np.random.default_rng(s)
+    sub = sorted({0, n // 2, n - 1, *map(int, rng.integers(0, n, 12))})
+    assert_same_bits(tabled[:, sub], reference_block(smp, [U32_MAX], [samples[k] for k in sub], dims), "vs reference")
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", 5), ("addelman-kempthorne", 9),
+                                     ("addelman-kempthorne", 27), ("addelman-kempthorne", 31),
+                                     ("bose-bush", 4), ("bose-bush", 16)])
+@pytest.mark.parametrize("offset", ["cmj", "centered"])
+def test_index2_table_and_direct_paths_agree(backend, name, s, offset, monkeypatch):
+    """All samples of a few pixels (the table path: kernels generate_tabled_addelman_kempthorne
+    and generate_tabled_bose_bush, NumPy's gather) and the same values with tables
+    switched off (the direct path) are the same bits, and match the reference."""
+    from pyoa.request import Request
+
+    N, d = 2 * s * s, 2 * s + 1
+    smp = pyoa.sampler(name, spp=N, dims=d + 2, seed=99, offset=offset, backend=backend)
+    pixels = [0, 7, U32_MAX]
+    req = smp._request(pixels, None, None)
+    assert req.table_entries == s + (2 * s if offset == "cmj" else 0) + 1
+    assert req.tables_pay_off(0, req.n_rows)
+    tabled = smp.generate(pixels=pixels)
+    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
+    direct = smp.generate(pixels=pixels)
+    assert_same_bits(tabled, direct, "table path vs direct path")
+    rng = np.random.default_rng(N)
+    samples = sorted({0, s * s - 1, s * s, N - 1, *map(int, rng.integers(0, N, 10))})
+    assert_same_bits(tabled[:, samples], reference_block(smp, pixels, samples, range(smp.dims)), "vs reference")
 
 
 def test_reference_is_not_backend_dependent_by_accident(backend):

@@ -296,3 +296,69 @@ def test_documented_moduli_table_matches():
             k = (int(m[3]) if m[3] else 1) if m[2] else 0
             coeffs[k] = c
         assert tuple(coeffs) == gf.modulus(q), (q, text)
+
+
+# ----------------------------------------------------------------------------- Addelman-Kempthorne constants
+
+#: Every odd prime power q <= 256 that is not a prime, small primes, and the largest
+#: Addelman-Kempthorne prime (2 * 2887^2 <= 2^24).
+AK_CONST_Q = [9, 25, 27, 49, 81, 121, 125, 169, 243, 3, 5, 7, 11, 13, 251, 2887]
+
+
+@pytest.mark.parametrize("q", AK_CONST_Q)
+def test_ak_constants_satisfy_their_definitions(q):
+    """pyoa.gf.ak_constants(q) = (kappa, b, k, c): kappa is a non-square of GF(q)
+    and the smallest one by code; for m = 1..q-1, b[m] * 4 kappa m = kappa - 1,
+    k[m] = kappa m and 4 c[m] = m^2 (kappa - 1), checked by multiplication only
+    in the independent field (4 = 1+1+1+1, which is 1 in characteristic 3);
+    index 0 is unused and 0. The same constants as the independent computation of
+    tests.helpers (inverses from a primitive element)."""
+    from tests.helpers import ak_constants_independent, field_for
+
+    F = field_for(q)
+    kappa, b, k, c = gf.ak_constants(q)
+    assert gf.ak_constants(q) is gf.ak_constants(q), "not cached"
+    assert all(isinstance(v, tuple) and len(v) == q and v[0] == 0 for v in (b, k, c))
+    squares = {F.mul(x, x) for x in range(q)}
+    assert len(squares) == (q + 1) // 2  # 0 and the (q-1)/2 nonzero squares
+    assert 0 < kappa < q and kappa not in squares
+    assert all(a in squares for a in range(kappa)), "kappa is not the smallest non-square"
+    p = factor_prime_power(q)[0]
+    if q == p:  # Euler's criterion, another test of non-squareness for prime q
+        assert pow(kappa, (q - 1) // 2, q) == q - 1
+    four = F.add(F.add(F.add(1, 1), 1), 1)
+    assert four == 4 % p
+    kappa_minus_1 = next(e for e in range(q) if F.add(e, 1) == kappa)
+    for m in range(1, q):
+        assert 0 <= b[m] < q and 0 <= k[m] < q and 0 <= c[m] < q
+        assert F.mul(b[m], F.mul(F.mul(four, kappa), m)) == kappa_minus_1, ("b", m)
+        assert k[m] == F.mul(kappa, m), ("k", m)
+        assert F.mul(four, c[m]) == F.mul(F.mul(m, m), kappa_minus_1), ("c", m)
+    assert (kappa, b, k, c) == ak_constants_independent(q)
+
+
+@pytest.mark.parametrize("q, kappa", [(3, 2), (5, 2), (7, 3), (11, 2), (13, 2), (17, 3), (23, 5), (2887, 3),
+                                      (9, 4), (25, 5)])
+def test_ak_smallest_non_squares(q, kappa):
+    """kappa by hand. Primes: the squares mod 7 are 1, 2, 4; mod 17 they include 1, 2,
+    4 but not 3; mod 23 they include 1, 2, 3, 4 but not 5; 2887 = 7 mod 8 makes 2 a
+    square, and 2887 = 3 mod 4, 2887 = 1 mod 3 make 3 a non-square (quadratic
+    reciprocity). GF(9) = GF(3)[i], i^2 = -1 (code a + 3b = a + b i): 1, 2 = i^2 and
+    3 = i = (1 + 2i)^2 are squares, 4 = 1 + i is not ((1 + i)^4 = -1). GF(25) with
+    modulus x^2 + 2: every element of GF(5) is a square in GF(25), and 5 = x has
+    order 8 (x^2 = 3 has order 4), which does not divide 24/2, so it is not."""
+    assert gf.ak_constants(q)[0] == kappa
+
+
+@pytest.mark.parametrize("q", [2, 4, 8, 16, 256])
+def test_ak_constants_refuse_even_q(q):
+    with pytest.raises(ValueError, match=f"odd.*{q}"):
+        gf.ak_constants(q)
+
+
+@pytest.mark.parametrize("q", [0, 1, 15, 45, 2889])
+def test_ak_constants_refuse_non_prime_powers(q):
+    """Like modulus() and tables(), a q that is no prime power is a ValueError that
+    names q, not an internal TypeError."""
+    with pytest.raises(ValueError, match=str(q)):
+        gf.ak_constants(q)

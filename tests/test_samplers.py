@@ -19,7 +19,9 @@ from tests.helpers import U32_MAX, assert_same_bits, reference_block
 @pytest.fixture(params=[pytest.param(("bose", 49, 11, None), id="bose"),
                         pytest.param(("cmjnd", 64, 7, 3), id="cmjnd"),
                         pytest.param(("bush", 64, 11, 3), id="bush"),
-                        pytest.param(("bose", 64, 11, None), id="bose-gf8")])
+                        pytest.param(("bose", 64, 11, None), id="bose-gf8"),
+                        pytest.param(("addelman-kempthorne", 50, 13, None), id="ak-q5"),
+                        pytest.param(("bose-bush", 32, 11, None), id="bb-s4")])
 def smp(request, backend):
     name, spp, dims, strength = request.param
     return pyoa.sampler(name, spp=spp, dims=dims, strength=strength, seed=123, backend=backend)
@@ -160,6 +162,72 @@ def test_valid_spp_bush_and_gf_bose():
     assert {4, 8, 9, 16, 25, 27, 32, 49, 64, 81, 121, 125, 128, 169, 243, 256} <= bose
     assert not bose & {6, 10, 12, 289, 343, 512, 625, 729, 1024, 2048, 4096}
     assert all(gf.is_supported(s) for s in bose)
+
+
+@pytest.mark.parametrize("name, spp, dims, s", [("addelman-kempthorne", 18, 20, 3), ("addelman-kempthorne", 162, 3, 9),
+                                                ("addelman-kempthorne", 2 * 2887**2, 1, 2887),
+                                                ("addelman-kempthorne", 2 * 243**2, 500, 243),
+                                                ("bose-bush", 8, 1, 2), ("bose-bush", 32, 20, 4),
+                                                ("bose-bush", 32768, 2, 128)])
+def test_index2_attributes_and_repr(backend, name, spp, dims, s):
+    """N = 2s^2 means s strata per axis, strength 2, blocks of 2s+1 dimensions and
+    M = 2s sub-strata, whatever dims is (no strength choice as for bush/cmjnd)."""
+    smp = pyoa.sampler(name.upper() if s == 3 else name, spp=spp, dims=dims, seed=9, backend=backend)
+    assert (smp.name, smp.spp, smp.dims, smp.s, smp.strength, smp.block_dims) == (name, spp, dims, s, 2, 2 * s + 1)
+    assert smp.params.M == 2 * s and smp.params.M * smp.s == spp
+    assert pyoa.sampler(name, spp=spp, dims=dims, strength=2, backend=backend).params == smp.params
+    r = repr(smp)
+    for part in (f"'{name}'", f"spp={spp}", f"s={s}", "strength=2", f"block_dims={2 * s + 1}"):
+        assert part in r, (part, r)
+    x = smp.generate(samples=[0, spp - 1], dims=[dims - 1])
+    assert x.shape == (1, 2, 1) and x.dtype == np.float32 and np.all((x >= 0) & (x < 1))
+
+
+def test_valid_spp_index2():
+    """The catalogue against an independent enumeration: Addelman-Kempthorne q odd,
+    a prime (up to 2887, the largest with 2q^2 <= 2^24) or a prime power <= 256;
+    Bose-Bush s = 2..128, powers of two (GF(2s) tables up to 256)."""
+    from tests.helpers import factor_prime_power, index2_levels
+
+    ak = pyoa.valid_spp("addelman-kempthorne")
+    want = [pyoa.SppChoice(2 * q * q, q, 2, 2 * q + 1) for q in index2_levels("addelman-kempthorne")]
+    assert ak == want
+    qs = [c.s for c in ak]
+    assert qs[:9] == [3, 5, 7, 9, 11, 13, 17, 19, 23] and qs[-1] == 2887 and 2 * 2887**2 <= 2**24
+    assert {9, 25, 27, 49, 81, 121, 125, 169, 243} <= set(qs)
+    assert not set(qs) & {2, 4, 8, 15, 21, 256, 289, 343, 625, 729, 1331, 2187, 2197, 2401}
+    assert all(factor_prime_power(q) and q % 2 for q in qs)
+    assert 2 * 2897**2 > 2**24  # 2897 is the next prime: too many samples
+    bb = pyoa.valid_spp("bose-bush")
+    assert bb == [pyoa.SppChoice(2 * s * s, s, 2, 2 * s + 1) for s in (2, 4, 8, 16, 32, 64, 128)]
+    assert [c.spp for c in bb] == [8, 32, 128, 512, 2048, 8192, 32768]
+    assert [c.label() for c in pyoa.valid_spp("bose-bush", near=100)] == ["32 (s=4)", "128 (s=8)"]
+    assert [c.label() for c in pyoa.valid_spp("addelman-kempthorne", near=100)] == ["50 (s=5)", "98 (s=7)"]
+    assert [c.spp for c in pyoa.valid_spp("addelman-kempthorne", near=162)] == [98, 162]  # |98-162| < |242-162|
+    for name in ("addelman-kempthorne", "bose-bush"):
+        assert pyoa.valid_spp(name, strength=2) == pyoa.valid_spp(name)
+        assert pyoa.valid_spp(name, strength=3) == []
+        assert pyoa.valid_spp(name, dims=1) == pyoa.valid_spp(name)
+
+
+def test_addelman_kempthorne_kernel_constants_layout():
+    """What the kernels read for Addelman-Kempthorne: [kappa, b[0..q), k[0..q), c[0..q)]
+    (kernels/oa.cl indexes ak[1 + m], ak[1 + q + m], ak[1 + 2q + m]); nothing for the others."""
+    from pyoa import constructions, gf
+
+    for q in (3, 27, 243, 2887):
+        c = constructions.get("addelman-kempthorne")
+        prm = c.resolve(2 * q * q, None, None)
+        kappa, b, k, cc = gf.ak_constants(q)
+        consts = c.constants(prm)
+        assert consts == [kappa, *b, *k, *cc] and len(consts) == 1 + 3 * q
+        assert all(0 <= v < q for v in consts)
+        assert c.field_order(prm) == q and c.shape_args(prm) == (q,)
+    bb = constructions.get("bose-bush")
+    prm = bb.resolve(32, None, None)
+    assert bb.constants(prm) == [] and bb.field_order(prm) == 8 and bb.shape_args(prm) == (4,)
+    assert bb.function == "bose_bush" and constructions.get("addelman-kempthorne").function == "addelman_kempthorne"
+    assert len({c.code for c in constructions.CONSTRUCTIONS.values()}) == len(constructions.CONSTRUCTIONS)
 
 
 def test_samplers_listing():
@@ -370,6 +438,37 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="cmjnd", spp=64, strength=0), ValueError, ["strength"]),
     (dict(name="cmjnd", spp=64, strength=25), ValueError, ["strength", "24"]),
     (dict(name="cmjnd", spp=64, strength=3.0), TypeError, ["strength"]),
+    # Addelman-Kempthorne: q odd, a prime (<= 2887) or an odd prime power <= 256
+    (dict(name="addelman-kempthorne", spp=32), ValueError, ["32", "odd", "18 (s=3)", "50 (s=5)",
+                                                            "32 is valid for bose-bush (s=4)"]),
+    (dict(name="addelman-kempthorne", spp=8), ValueError, ["8", "odd", "18 (s=3)", "50 (s=5)", "bose-bush (s=2)"]),
+    (dict(name="addelman-kempthorne", spp=2 * 15**2), ValueError, ["450", "odd prime", "338 (s=13)", "578 (s=17)"]),
+    (dict(name="addelman-kempthorne", spp=2 * 289**2), ValueError, ["167042", "prime power (<= 256)",
+                                                                    "160178 (s=283)", "171698 (s=293)"]),
+    (dict(name="addelman-kempthorne", spp=2 * 343**2), ValueError, ["235298", "227138 (s=337)", "240818 (s=347)"]),
+    (dict(name="addelman-kempthorne", spp=2 * 2889**2), ValueError, ["16692642", "2887",
+                                                                     "16577282 (s=2879)", "16669538 (s=2887)"]),
+    (dict(name="addelman-kempthorne", spp=2 * 2903**2), ValueError, ["spp", "16777216"]),
+    (dict(name="addelman-kempthorne", spp=49), ValueError, ["49", "18 (s=3)", "50 (s=5)",
+                                                            "valid for bose (s=7), bush (s=7), cmjnd (s=7)"]),
+    (dict(name="addelman-kempthorne", spp=19), ValueError, ["19", "18 (s=3)", "50 (s=5)"]),
+    (dict(name="addelman-kempthorne", spp=1), ValueError, ["18 (s=3)"]),
+    (dict(name="addelman-kempthorne", spp=18, strength=3), ValueError, ["strength 2 only", "strength=3"]),
+    (dict(name="addelman-kempthorne", spp=18, strength=1), ValueError, ["strength 2 only"]),
+    (dict(name="addelman-kempthorne", spp=18, strength=2.0), TypeError, ["strength"]),
+    # Bose-Bush: s a power of two up to 128
+    (dict(name="bose-bush", spp=18), ValueError, ["18", "power of two", "8 (s=2)", "32 (s=4)",
+                                                  "18 is valid for addelman-kempthorne (s=3)"]),
+    (dict(name="bose-bush", spp=2 * 6**2), ValueError, ["72", "power of two", "32 (s=4)", "128 (s=8)"]),
+    (dict(name="bose-bush", spp=2 * 256**2), ValueError, ["131072", "128", "8192 (s=64)", "32768 (s=128)"]),
+    (dict(name="bose-bush", spp=2 * 2887**2), ValueError, ["8192 (s=64)", "32768 (s=128)",
+                                                           "valid for addelman-kempthorne (s=2887)"]),
+    (dict(name="bose-bush", spp=64), ValueError, ["64", "32 (s=4)", "bose (s=8)", "bush (s=4, t=3)"]),
+    (dict(name="bose-bush", spp=2), ValueError, ["2", "8 (s=2)", "32 (s=4)"]),
+    (dict(name="bose-bush", spp=33), ValueError, ["33", "32 (s=4)"]),
+    (dict(name="bose-bush", spp=32, strength=3), ValueError, ["strength 2 only", "strength=3"]),
+    (dict(name="bose-bush", spp=32, strength=4), ValueError, ["strength 2 only"]),
+    (dict(name="bose-bush", spp=32, strength=0), ValueError, ["strength"]),
     (dict(name="bose", spp=121, dims=0), ValueError, ["dims"]),
     (dict(name="bose", spp=121, dims=-2), ValueError, ["dims"]),
     (dict(name="bose", spp=121, dims=2**20 + 1), ValueError, ["dims", "1048576"]),

@@ -99,3 +99,54 @@ def test_bush_cell_is_the_polynomial_array(s, t):
     assert np.array_equal(aij[:, s], rows // M)
     assert np.array_equal(aij[:, 0], rows % s)  # f(0) = c_0
     assert aij.max() < s and u.max() < M
+
+
+# ----------------------------------------------------------------------------- index 2: Addelman-Kempthorne, Bose-Bush
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+@pytest.mark.parametrize("p", [0, 1, U32_MAX])
+@pytest.mark.parametrize("name, s", [("addelman_kempthorne", 3), ("addelman_kempthorne", 9),
+                                     ("bose_bush", 2), ("bose_bush", 8)])
+def test_index2_equals_reference_including_seed_zero(name, s, p, offset):
+    """Every sample, the 2s+1 columns of blocks 0 and 1 and the first of block 2."""
+    N, d = 2 * s * s, 2 * s + 1
+    i = np.arange(N, dtype=U32)[:, None]
+    j = np.arange(2 * d + 1, dtype=U32)[None, :]
+    got = getattr(noa, name)(i, j, s, U32(p), offset, 0.3)
+    fn = getattr(ref, name)
+    want = np.array([[fn(a, b, s, p, offset, 0.3) for b in range(j.size)] for a in range(N)], np.float32)
+    assert_same_bits(got, want, f"{name} s={s} p={p} {offset}")
+
+
+def _sample_rows_cols(s, n_rows, n_cols, seed):
+    """Rows of both halves (the first, last and boundary rows) and columns (the first,
+    the boundaries q-1, q, q+1 and the last ones) plus random ones."""
+    rng = np.random.default_rng(seed)
+    N, d = 2 * s * s, 2 * s + 1
+    rows = sorted({0, 1, s - 1, s, s * s - 1, s * s, s * s + 1, N - s, N - 1, *map(int, rng.integers(0, N, n_rows))})
+    cols = sorted({0, 1, 2, s - 2, s - 1, s, s + 1, s + 2, 2 * s - 2, 2 * s - 1, 2 * s,
+                   *map(int, rng.integers(0, d, n_cols))} & set(range(d)))
+    return rows, cols
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", q) for q in (3, 5, 9, 13, 25, 27, 243, 251, 2887)]
+                         + [("bose-bush", s) for s in (2, 4, 8, 16, 32, 64, 128)])
+def test_index2_cell_is_the_plain_array(name, s):
+    """addelman_kempthorne_cell / bose_bush_cell over whole columns against the
+    independent plain arrays and the documented sub-stratum index u (whole arrays
+    up to N = 2048, sampled rows and columns, both halves and the last column,
+    for the larger ones); symbols in [0, s), u in [0, 2s)."""
+    from tests.helpers import index2_symbol, plain_index2_array
+
+    N, d = 2 * s * s, 2 * s + 1
+    cell = noa.addelman_kempthorne_cell if name == "addelman-kempthorne" else noa.bose_bush_cell
+    if N <= 2048:
+        A, U = plain_index2_array(name, s)
+        aij, u = cell(np.arange(N, dtype=U32)[:, None], np.arange(d, dtype=U32)[None, :], s)
+        assert np.array_equal(aij, A) and np.array_equal(u, U)
+        return
+    rows, cols = _sample_rows_cols(s, 12 if s > 256 else 30, 40 if s > 64 else d, s)
+    aij, u = cell(np.array(rows, U32)[:, None], np.array(cols, U32)[None, :], s)
+    want = np.array([[index2_symbol(name, i, j, s) for j in cols] for i in rows])
+    assert np.array_equal(aij, want[..., 0]) and np.array_equal(u, want[..., 1])
+    assert aij.max() < s and u.max() < 2 * s

@@ -52,3 +52,18 @@ def test_tables_and_direct_kernels_agree(opencl):
         few = np.concatenate([smp.generate(pixels=[0, 2**32 - 1], samples=range(k, min(k + 10, 121)))
                               for k in range(0, 121, 10)], axis=1)  # 10 samples: direct kernel
         assert_same_bits(full, few, offset)
+
+
+def test_index2_constants_and_fields_follow_each_sampler(opencl):
+    """One backend object serves Addelman-Kempthorne of several orders (each with its
+    own constants buffer, GF(9) tables or none) and Bose-Bush (GF(2s) tables, no
+    constants), interleaved with Bose: every launch reads its own, for both kernels
+    (the table path for cmj, the direct one for mj)."""
+    cases = [("addelman-kempthorne", 18), ("addelman-kempthorne", 50), ("bose-bush", 8), ("bose", 64),
+             ("addelman-kempthorne", 162), ("bose-bush", 32), ("addelman-kempthorne", 18), ("bose-bush", 8)]
+    for offset in ("cmj", "mj"):
+        for name, spp in cases:
+            smp = pyoa.sampler(name, spp=spp, dims=9, seed=3, offset=offset, backend="opencl")
+            assert smp._backend is opencl
+            want = pyoa.sampler(name, spp=spp, dims=9, seed=3, offset=offset, backend="numpy").generate(pixels=[0, 5])
+            assert_same_bits(smp.generate(pixels=[0, 5]), want, f"{name} spp={spp} {offset}")

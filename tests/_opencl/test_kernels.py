@@ -53,6 +53,26 @@ __kernel void t_bush(__global const uint *i, __global const uint *j, const uint 
                      __global const uint *p, const uint offset, const float J, __global const ushort *gf,
                      const uint tabled, __global float *out)
 { size_t g = get_global_id(0); out[g] = bush(i[g], j[g], s, t, p[g], offset, J, gf, tabled); }
+
+__kernel void t_addelman_kempthorne(__global const uint *i, __global const uint *j, const uint s,
+                                    __global const uint *p, const uint offset, const float J,
+                                    __global const ushort *gf, const uint tabled, __global const uint *ak,
+                                    __global float *out)
+{ size_t g = get_global_id(0); out[g] = addelman_kempthorne(i[g], j[g], s, p[g], offset, J, gf, tabled, ak); }
+
+__kernel void t_bose_bush(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
+                          const uint offset, const float J, __global const ushort *gf, const uint tabled,
+                          __global float *out)
+{ size_t g = get_global_id(0); out[g] = bose_bush(i[g], j[g], s, p[g], offset, J, gf, tabled); }
+
+__kernel void t_ak_cell(__global const uint *i, __global const uint *j, const uint q, __global const ushort *gf,
+                        const uint tabled, __global const uint *ak, __global uint *aij, __global uint *u)
+{ size_t g = get_global_id(0); uint a, b; addelman_kempthorne_cell(i[g], j[g], q, gf, tabled, ak, &a, &b);
+  aij[g] = a; u[g] = b; }
+
+__kernel void t_bb_cell(__global const uint *i, __global const uint *j, const uint s, __global const ushort *gf,
+                        const uint tabled, __global uint *aij, __global uint *u)
+{ size_t g = get_global_id(0); uint a, b; bose_bush_cell(i[g], j[g], s, gf, tabled, &a, &b); aij[g] = a; u[g] = b; }
 """
 
 
@@ -245,3 +265,88 @@ def test_gf_bose_and_bush_match_reference_including_seed_zero(harness, field_arg
         got = harness("t_bush", [np.float32], i, j, U32(s), U32(t), p, U32(code), np.float32(1.0), *field_args(s))
         want = np.array([ref.bush(int(a), int(b), s, t, int(c), offset, 1.0) for a, b, c in zip(i, j, p)], np.float32)
         assert_same_bits(got, want, f"bush s={s} t={t}")
+
+
+
+# ----------------------------------------------------------------------------- index 2: Addelman-Kempthorne, Bose-Bush
+
+@pytest.fixture(scope="module")
+def ak_consts(opencl):
+    """``q -> buffer`` of [kappa, b, k, c], as the backend uploads it (Construction.constants)."""
+    import pyopencl as cl
+
+    from pyoa import constructions
+
+    def buf(q):
+        c = constructions.get("addelman-kempthorne")
+        vals = np.array(c.constants(c.resolve(2 * q * q, None, None)), dtype=U32)
+        return cl.Buffer(opencl.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=vals)
+
+    return buf
+
+
+def _index2_rows_cols(s, n, rng):
+    """n (i, j) pairs: the edges (first/last sample, both halves, the last column
+    j = 2s, the first column of the next block) then random ones over three blocks."""
+    N, d = 2 * s * s, 2 * s + 1
+    edge_i = [0, N - 1, s * s - 1, s * s, N - 1, 0, s * s]
+    edge_j = [0, 2 * s, 2 * s, s, d, 3 * d - 1, s - 1]
+    i = np.concatenate([edge_i, rng.integers(0, N, n - len(edge_i))]).astype(U32)
+    j = np.concatenate([edge_j, rng.integers(0, 3 * d, n - len(edge_j))]).astype(U32)
+    return i, j
+
+
+@pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
+def test_index2_kernels_match_reference_including_seed_zero(harness, field_args, ak_consts, offset):
+    """kernels/oa.cl addelman_kempthorne (GF(q) tables for 9, 27, 243; mod q for
+    3, 7, 251, 2887) and bose_bush (GF(2s) tables, s = 2 .. 128), one value at a
+    time, against the reference."""
+    from pyoa import reference as ref
+
+    code = {"centered": 0, "j": 1, "mj": 2, "cmj": 3}[offset]
+    rng = np.random.default_rng(20 + code)
+    seeds = np.array([0, 1, U32_MAX, 0x12345678], U32)
+    for q in (3, 9, 27, 243, 7, 251, 2887):
+        i, j = _index2_rows_cols(q, 150, rng)
+        p = rng.choice(seeds, len(i))
+        got = harness("t_addelman_kempthorne", [np.float32], i, j, U32(q), p, U32(code), np.float32(0.625),
+                      *field_args(q), ak_consts(q))
+        want = np.array([ref.addelman_kempthorne(int(a), int(b), q, int(c), offset, 0.625)
+                         for a, b, c in zip(i, j, p)], np.float32)
+        assert_same_bits(got, want, f"addelman-kempthorne q={q}")
+    for s in (2, 4, 8, 16, 32, 64, 128):
+        i, j = _index2_rows_cols(s, 150, rng)
+        p = rng.choice(seeds, len(i))
+        got = harness("t_bose_bush", [np.float32], i, j, U32(s), p, U32(code), np.float32(1.0), *field_args(2 * s))
+        want = np.array([ref.bose_bush(int(a), int(b), s, int(c), offset, 1.0) for a, b, c in zip(i, j, p)],
+                        np.float32)
+        assert_same_bits(got, want, f"bose-bush s={s}")
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", q) for q in (3, 5, 9, 25, 27, 243, 2887)]
+                         + [("bose-bush", s) for s in (2, 8, 32, 128)])
+def test_index2_cells_are_the_plain_arrays(harness, field_args, ak_consts, name, s):
+    """addelman_kempthorne_cell / bose_bush_cell of the kernels over every entry of
+    the array (N <= 2048) against the independent plain arrays; for the larger ones
+    every column of sampled rows against NumPy's cells (themselves checked against
+    the plain arrays in tests/_numpy/test_oa.py)."""
+    from pyoa._numpy import oa as noa
+    from tests.helpers import plain_index2_array
+
+    N, d = 2 * s * s, 2 * s + 1
+    if N <= 2048:
+        i, j = (x.ravel().astype(U32) for x in np.meshgrid(np.arange(N), np.arange(d), indexing="ij"))
+    else:
+        rows = np.random.default_rng(s).integers(0, N, 40 if s < 2887 else 4).tolist() + [0, s * s - 1, s * s, N - 1]
+        i, j = (x.ravel().astype(U32) for x in np.meshgrid(rows, np.arange(d), indexing="ij"))
+    if name == "addelman-kempthorne":
+        aij, u = harness("t_ak_cell", [U32, U32], i, j, U32(s), *field_args(s), ak_consts(s))
+        want = noa.addelman_kempthorne_cell(i, j, s)
+    else:
+        aij, u = harness("t_bb_cell", [U32, U32], i, j, U32(s), *field_args(2 * s))
+        want = noa.bose_bush_cell(i, j, s)
+    if N <= 2048:
+        A, U = plain_index2_array(name, s)
+        assert np.array_equal(aij.reshape(N, d), A) and np.array_equal(u.reshape(N, d), U)
+    assert np.array_equal(aij, want[0]) and np.array_equal(u, want[1])
+    assert aij.max() < s and u.max() < 2 * s

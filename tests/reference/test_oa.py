@@ -20,8 +20,14 @@ from pyoa import reference as ref
 from pyoa._numpy import oa as noa
 from pyoa.reference.floats import jitter_value, sample_value
 from tests.helpers import (
+    AK_Q,
+    BB_S,
     OFFSET_CODE,
     U32_MAX,
+    ak_constants_independent,
+    index2_symbol,
+    plain_ak_array,
+    plain_index2_array,
     bush_sub_index,
     bush_symbol,
     field_for,
@@ -269,10 +275,13 @@ def _canonical(fn, N, d, **kw):
     from the reference for small N, else from the NumPy functions (bit-equal to
     the reference at seed 0: tests/_numpy/test_oa.py)."""
     if N * d <= 6000:
+        if fn == "addelman_kempthorne":  # its reference calls the order q
+            return _ref_array(getattr(ref, fn), N, range(d), p=0, q=kw["s"],
+                              **{k: v for k, v in kw.items() if k != "s"})
         return _ref_array(getattr(ref, fn), N, range(d), p=0, **kw)
     i = np.arange(N, dtype=np.uint32)[:, None]
     j = np.arange(d, dtype=np.uint32)[None, :]
-    args = (kw["s"],) if fn == "bose" else (kw["s"], kw["t"])
+    args = (kw["s"],) if fn in ("bose", "addelman_kempthorne", "bose_bush") else (kw["s"], kw["t"])
     return getattr(noa, fn)(i, j, *args, np.uint32(0), kw["offset"], kw.get("jitter", 1.0))
 
 
@@ -518,6 +527,197 @@ def test_bush_latin_many_seeds(backend, s, t):
             assert_oa(strata_exact(x, s), s, t, cols=range(d) if d <= 6 else [0, 1, s - 1, s])
 
 
+# ----------------------------------------------------------------------------- index 2: Addelman-Kempthorne, Bose-Bush
+
+INDEX2 = [pytest.param("addelman-kempthorne", q, id=f"ak-q{q}") for q in AK_Q] + \
+         [pytest.param("bose-bush", s, id=f"bb-s{s}") for s in BB_S]
+
+
+@pytest.mark.parametrize("name, s", INDEX2)
+def test_index2_canonical_array_is_the_plain_array(name, s):
+    """Seed 0 (identity permutations, jitter 0.5) is the plain array, recomputed
+    independently (tests.helpers: the Addelman-Kempthorne table of Hedayat-Sloane-
+    Stufken 3.4 with constants from an independent GF(q); Bose-Bush in an
+    independent GF(2s)): strata = A, fine cell = A*M + u with pyoa's documented
+    sub-stratum index u (M = 2s). A is an OA of strength 2 and index 2 in every
+    pair of ALL 2s+1 columns (each of the s^2 cells exactly twice), and A*M + u
+    is a permutation of the N = 2s^2 fine cells in every column."""
+    N, M, d = 2 * s * s, 2 * s, 2 * s + 1
+    A, U = plain_index2_array(name, s)
+    assert A.shape == U.shape == (N, d)
+    rng = np.random.default_rng(N)
+    for i in [0, 1, s * s - 1, s * s, N - 1] + [int(v) for v in rng.integers(0, N, 20)]:  # vectorized == scalar
+        assert [index2_symbol(name, i, j, s) for j in range(d)] == list(zip(A[i].tolist(), U[i].tolist())), i
+    assert_oa(A, s, 2, what=f"plain {name} s={s}")
+    assert A.min() == 0 and A.max() == s - 1 and U.min() == 0 and U.max() == M - 1
+    assert np.array_equal(np.sort(A * M + U, axis=0), np.broadcast_to(np.arange(N)[:, None], (N, d)))
+    fn = name.replace("-", "_")
+    for offset in ("cmj", "mj", "j") if N * d <= 6000 else ("cmj",):
+        x = _canonical(fn, N, d, s=s, offset=offset)
+        assert np.array_equal(strata_exact(x, s), A), offset
+        assert np.array_equal(np.floor(x.astype(np.float64) * N), A * M + U), offset
+        assert_latin_exact(x, N, f"canonical {name} s={s} {offset}")
+    x = _canonical(fn, N, d, s=s, offset="centered")
+    assert_same_bits(x, ((A + 0.5) / s).astype(np.float32), "canonical centred")
+
+
+def test_index2_plain_arrays_written_out():
+    """The smallest arrays by hand. Addelman-Kempthorne q = 3: kappa = 2, b = (0, 2, 1),
+    k = (0, 2, 1), c = (0, 1, 1); rows (h, x, y) in order. Bose-Bush s = 2 over GF(4)
+    (x^2 + x + 1): the products x*j of GF(4), low bit, plus k."""
+    assert ak_constants_independent(3) == (2, (0, 2, 1), (0, 2, 1), (0, 1, 1))
+    A = plain_ak_array(3)[0]
+    assert A.T.tolist() == [
+        [0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2],  # y
+        [0, 1, 2, 1, 2, 0, 2, 0, 1, 2, 0, 1, 0, 1, 2, 1, 2, 0],  # x + y (+ 2)
+        [0, 2, 1, 1, 0, 2, 2, 1, 0, 1, 0, 2, 2, 1, 0, 0, 2, 1],  # x + 2y (+ 1)
+        [0, 1, 2, 1, 2, 0, 1, 2, 0, 0, 1, 2, 2, 0, 1, 2, 0, 1],  # y + x^2, y + 2 x^2
+        [0, 1, 2, 2, 0, 1, 0, 1, 2, 1, 2, 0, 2, 0, 1, 1, 2, 0],  # y + x + x^2, y + 2x + 2x^2 + 1
+        [0, 1, 2, 0, 1, 2, 2, 0, 1, 1, 2, 0, 1, 2, 0, 2, 0, 1],  # y + 2x + x^2, y + x + 2x^2 + 1
+        [0, 0, 0, 1, 1, 1, 2, 2, 2, 0, 0, 0, 1, 1, 1, 2, 2, 2],  # x
+    ]
+    B = plain_index2_array("bose-bush", 2)[0]
+    assert B.T.tolist() == [
+        [0, 1, 0, 1, 0, 1, 0, 1],  # low bit of x*0 = 0, 0, 0, 0 (x = 0..3), plus k
+        [0, 1, 1, 0, 0, 1, 1, 0],  # x*1 = 0, 1, 2, 3
+        [0, 1, 0, 1, 1, 0, 1, 0],  # x*2 = 0, 2, 3, 1
+        [0, 1, 1, 0, 1, 0, 0, 1],  # x*3 = 0, 3, 1, 2
+        [0, 0, 1, 1, 0, 0, 1, 1],  # x mod 2
+    ]
+
+
+@pytest.mark.parametrize("q", [3, 5, 7, 9, 25])
+def test_ak_needs_a_non_square_kappa(q):
+    """The construction's one condition: with a square in place of kappa (1, whose
+    constants are b = c = 0 and k = m) the array is not an OA, and the OA check
+    says so; another non-square (the largest, Owen's choice) gives an OA too."""
+    from tests.helpers import field_for
+
+    F = field_for(q)
+    squares = {F.mul(x, x) for x in range(q)}
+    with pytest.raises(AssertionError, match="not an OA"):
+        assert_oa(plain_ak_array(q, 1)[0], q, 2)
+    largest = max(x for x in range(q) if x not in squares)
+    assert_oa(plain_ak_array(q, largest)[0], q, 2, what=f"AK q={q} kappa={largest}")
+    if q > 3:
+        square = max(squares)
+        with pytest.raises(AssertionError, match="not an OA"):
+            assert_oa(plain_ak_array(q, square)[0], q, 2)
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", 3), ("addelman-kempthorne", 5), ("addelman-kempthorne", 9),
+                                     ("bose-bush", 2), ("bose-bush", 4), ("bose-bush", 8)])
+def test_index2_last_column_adds_only_triple_coincidences(name, s):
+    """The documented cost of the full column set: two rows agree in at most 2 of
+    the first 2s columns, and the last column (j = 2s) adds pairs of rows that agree
+    in exactly 3 (s^3 such pairs); strength 2 is kept (test above). Randomizing the
+    symbols per column (any pixel of the sampler) does not change coincidences."""
+    A = plain_index2_array(name, s)[0]
+    x = pyoa.sampler(name, spp=2 * s * s, dims=2 * s + 1, seed=5, jitter=0.0, backend="numpy").generate(pixels=[3])[0]
+    for arr in (A, strata_exact(x, s)):
+        agree = arr[:, None, :] == arr[None, :, :]
+        iu = np.triu_indices(len(arr), 1)
+        assert agree[..., :-1].sum(-1)[iu].max() == 2
+        full = agree.sum(-1)[iu]
+        assert full.max() == 3 and np.count_nonzero(full == 3) == s**3
+
+
+def _index2_from_spec(name, i, j, s, p, offset, jitter):
+    """One value of an index-2 sampler written out from the docstrings of
+    reference.addelman_kempthorne / bose_bush, with the independent plain arrays:
+    blocks of 2s+1 columns, M = 2s, the 'j' seed (i + 1) P2."""
+    M = 2 * s
+    block, j = divmod(j, 2 * s + 1)
+    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    aij, u = index2_symbol(name, i, j, s)
+    stratum = ref.permute(aij, s, P1)
+    if offset == "centered":
+        sub = (M - 1) / 2
+    else:
+        seed = {"j": (i + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
+        sub = ref.permute(u, M, seed)
+    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), M, s)
+
+
+@pytest.mark.parametrize("name, s", [*INDEX2, pytest.param("addelman-kempthorne", 243, id="ak-q243"),
+                                     pytest.param("addelman-kempthorne", 2887, id="ak-q2887"),
+                                     pytest.param("addelman-kempthorne", 251, id="ak-q251"),
+                                     pytest.param("bose-bush", 128, id="bb-s128")])
+def test_index2_reference_follows_spec(name, s):
+    """Whole values (permutations, offsets, jitter, blocks) of the reference against
+    the documented construction with an independent field: random rows, columns in
+    three blocks, the last sample and the last column j = 2s, edge seeds."""
+    rng = np.random.default_rng(s + (0 if name == "bose-bush" else 10**6))
+    N, d = 2 * s * s, 2 * s + 1
+    for k in range(100 if s <= 256 else 25):
+        i, j = int(rng.integers(0, N)), int(rng.integers(0, 3 * d))
+        if k < 5:
+            i, j = [(N - 1, 2 * s), (N - 1, d), (0, 2 * d - 1), (s * s, 2 * s), (s * s - 1, s)][k]
+        p = int(rng.choice([0, 1, U32_MAX])) if k % 4 == 0 else int(rng.integers(0, 2**32))
+        offset, J = OFFSETS[k % 4], [1.0, 0.0, 0.8125][k % 3]
+        fn = getattr(ref, name.replace("-", "_"))
+        assert _same_f32(fn(i, j, s, p, offset, J), _index2_from_spec(name, i, j, s, p, offset, J)), \
+            (name, i, j, s, p, offset, J)
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", 3), ("addelman-kempthorne", 5), ("bose-bush", 2),
+                                     ("bose-bush", 4)])
+def test_index2_oa_reference(name, s):
+    N, d = 2 * s * s, 2 * s + 1
+    fn = getattr(ref, name.replace("-", "_"))
+    plain = plain_index2_array(name, s)[0]
+    for p in (1, U32_MAX):
+        for offset in OFFSETS:
+            x0 = _ref_array(lambda i, j, **kw: fn(i, j, s, **kw), N, range(d), p=p, offset=offset, jitter=0.0)
+            x1 = _ref_array(lambda i, j, **kw: fn(i, j, s, **kw), N, range(d), p=p, offset=offset, jitter=1.0)
+            check_array(x0, x1, s, 2, N, [range(d)], offset, f"{name} s={s} p={p} {offset}")
+            if s >= 3:
+                assert not np.array_equal(strata_exact(x0, s), plain)
+
+
+#: (name, s, offset) of the bulk property test: every offset for the smaller arrays,
+#: the Latin-hypercube offsets (cmj: the table path; mj: the direct path) for the larger
+INDEX2_BULK = [pytest.param(name, s, offset, id=f"{tag}{s}-{offset}")
+               for name, tag, levels in (("addelman-kempthorne", "ak-q", AK_Q), ("bose-bush", "bb-s", BB_S))
+               for s in levels
+               for offset in (OFFSETS if s <= 13 else ("cmj", "mj") if s < 32 else ("cmj",))]
+
+
+@pytest.mark.parametrize("name, s, offset", INDEX2_BULK)
+def test_index2_oa_bulk(backend, name, s, offset):
+    """Many seeds (pixels), both backends: every pair of ALL 2s+1 columns of each
+    block shows each of the s^2 cells exactly twice (index 2), mj/cmj are Latin
+    hypercubes at N = 2s^2 cells in every column (the last one included), values
+    lie in [0, 1), and blocks past the first (dimensions past 2s+1, the partial
+    third block too) are differently randomized valid copies."""
+    N, d = 2 * s * s, 2 * s + 1
+    dims = 2 * d + 2
+    seed = {"centered": 0, "j": 7, "mj": 0xDEADBEEF, "cmj": U32_MAX}[offset]
+    x0, x1 = _bulk(name, N, dims, backend, offset, seed=seed, n_pixels=4 if s >= 32 else _pixels_for(N * d // 6))
+    check_blocks(x0, x1, s, 2, N, d, 2, offset, f"{name} s={s} {offset} seed={seed} [{backend}]")
+    assert_oa(strata_exact(x0, s), s, 2, cols=range(2 * d, dims))
+    if s >= 3:  # each pixel's array is randomized, not the canonical one
+        plain = plain_index2_array(name, s)[0]
+        assert not (strata_exact(x0[..., :d], s) == plain).all(axis=(-2, -1)).any()
+
+
+@pytest.mark.parametrize("name, s", [("addelman-kempthorne", 3), ("addelman-kempthorne", 9),
+                                     ("addelman-kempthorne", 49), ("addelman-kempthorne", 61),
+                                     ("bose-bush", 2), ("bose-bush", 8), ("bose-bush", 32), ("bose-bush", 64)])
+def test_index2_latin_many_seeds(backend, name, s):
+    """mj and cmj: 1D Latin hypercube at N = 2s^2 cells in every column, the last
+    one (j = 2s) included, over many seeds (pixels x user seeds)."""
+    N, d = 2 * s * s, 2 * s + 1
+    cols = range(d) if d <= 20 else [0, 1, s - 1, s, s + 1, 2 * s - 1, 2 * s]
+    for offset in ("mj", "cmj"):
+        for seed in (1, 2**31, U32_MAX):
+            x = pyoa.sampler(name, spp=N, dims=d, seed=seed, offset=offset, jitter=0.0,
+                             backend=backend).generate(pixels=range(max(2, 6000 // N)), dims=cols)
+            assert in_unit_interval(x)
+            assert_latin_exact(x, N, f"{name} s={s} {offset} seed={seed}")
+            assert_oa(strata_exact(x, s), s, 2)
+
+
 # ----------------------------------------------------------------------------- unbiasedness (SPEC 8.6)
 
 def _f_cos(x):
@@ -541,7 +741,9 @@ def _f_step(x):
     "name, spp, dims, strength, offset",
     [("bose", 49, 11, None, "cmj"), ("bose", 121, 5, None, "j"), ("cmjnd", 64, 7, 3, "cmj"),
      ("cmjnd", 81, 6, 2, "mj"), ("bose", 25, 4, None, "mj"), ("cmjnd", 9, 3, 1, "j"),
-     ("bose", 64, 11, None, "cmj"), ("bush", 64, 7, 3, "cmj"), ("bush", 81, 5, 2, "mj"), ("bush", 256, 6, 4, "j")],
+     ("bose", 64, 11, None, "cmj"), ("bush", 64, 7, 3, "cmj"), ("bush", 81, 5, 2, "mj"), ("bush", 256, 6, 4, "j"),
+     ("addelman-kempthorne", 50, 13, None, "cmj"), ("addelman-kempthorne", 18, 9, None, "j"),
+     ("bose-bush", 32, 11, None, "mj"), ("bose-bush", 8, 6, None, "cmj")],
 )
 def test_estimates_are_unbiased(backend, name, spp, dims, strength, offset):
     """Mean over pixels (independent arrays) of the per-pixel estimate is within 5
@@ -606,3 +808,36 @@ def test_reference_bush_refuses_bad_arguments(kw, words):
     if "i" not in kw and "j" not in kw:
         with pytest.raises(ValueError):
             ref.bose(**{k: v for k, v in args.items() if k != "t"})
+
+
+@pytest.mark.parametrize("q", [1, 2, 4, 8, 15, 45, 256, 289, 343, 729, 4096])
+def test_reference_addelman_kempthorne_refuses_unsupported_q(q):
+    """q must be odd and a prime, or a prime power <= 256 (289 = 17^2, 343 = 7^3 and
+    729 = 3^6 have no tables)."""
+    with pytest.raises(ValueError, match=f"odd prime.*got {q}$"):
+        ref.addelman_kempthorne(0, 0, q, 0)
+
+
+@pytest.mark.parametrize("s", [0, 1, 3, 6, 12, 256, 512])
+def test_reference_bose_bush_refuses_unsupported_s(s):
+    with pytest.raises(ValueError, match=f"power of two.*got {s}$"):
+        ref.bose_bush(0, 0, s, 0)
+
+
+@pytest.mark.parametrize("fn, s", [(ref.addelman_kempthorne, 3), (ref.bose_bush, 4)])
+@pytest.mark.parametrize("kw, words", [
+    (dict(i="N"), ["[0, N)"]), (dict(i=-1), ["[0, N)"]), (dict(j=-1), ["dimension"]),
+    (dict(p=2**32), ["seed"]), (dict(p=-1), ["seed"]), (dict(offset="cj"), ["offset", "'cj'"]),
+    (dict(jitter=1.5), ["jitter"]), (dict(jitter=float("nan")), ["jitter"]),
+])
+def test_reference_index2_refuses_bad_arguments(fn, s, kw, words):
+    N = 2 * s * s
+    args = {"i": 0, "j": 0, "p": 0, "offset": "cmj", "jitter": 1.0, **kw}
+    if args["i"] == "N":
+        args["i"] = N
+    with pytest.raises(ValueError) as info:
+        fn(args["i"], args["j"], s, args["p"], args["offset"], args["jitter"])
+    for w in words:
+        assert w.replace("N", str(N)) in str(info.value)
+    # the last sample and any dimension are fine
+    assert 0 <= fn(N - 1, 10 * (2 * s + 1), s, U32_MAX) < 1
