@@ -20,6 +20,7 @@ constructions form (``s*s``, ``A_ik*s + A_ij + 1``, ``s**t``) stays below
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from functools import lru_cache
@@ -114,6 +115,21 @@ def nearest(choices: list[SppChoice], spp: int, k: int = 2) -> list[SppChoice]:
     returned in increasing order of sample count."""
     best = sorted(choices, key=lambda c: (abs(c.spp - spp), c.spp))[:k]
     return sorted(best, key=lambda c: c.spp)
+
+
+def _power_candidates(spp: int, strengths, valid, block_dims) -> list[SppChoice]:
+    """Counts ``s**t`` that can be among the two nearest to ``spp``: for each
+    strength t, the two valid s at or below ``spp**(1/t)`` and the two above
+    (``s**t <= MAX_SPP``). Searching outwards from the root instead of listing
+    every count matters: at t = 1 there are 16.7 million counts."""
+    out = []
+    for t in strengths:
+        s_max = integer_root_floor(MAX_SPP, t)
+        root = min(max(int(round(max(spp, 1) ** (1.0 / t))), 2), s_max)
+        for side in (range(root, 1, -1), range(root + 1, s_max + 1)):
+            found = list(itertools.islice((s for s in side if valid(s, t)), 2))
+            out += [SppChoice(s**t, s, t, block_dims(s, t)) for s in found]
+    return out
 
 
 def _labels(choices: list[SppChoice]) -> str:
@@ -240,14 +256,8 @@ class Bush(Construction):
         return sorted(out)
 
     def nearest(self, spp, dims=None, strength=None):
-        cands = []
-        for t in self._strengths(dims, strength):
-            root = int(round(max(spp, 1) ** (1.0 / t)))
-            s_max = integer_root_floor(MAX_SPP, t)
-            near = [s for s in range(max(2, t, root - 8), min(s_max, root + 8) + 1) if gf.is_supported(s)]
-            below = [s for s in range(min(s_max, root), max(1, t - 1), -1) if gf.is_supported(s)][:1]
-            cands += [SppChoice(s**t, s, t, s + 1) for s in {*near, *below}]
-        return nearest(cands, spp)
+        return nearest(_power_candidates(spp, self._strengths(dims, strength),
+                                         lambda s, t: s >= t and gf.is_supported(s), lambda s, t: s + 1), spp)
 
     def solve(self, spp, dims, strength):
         if strength is not None and not 2 <= strength <= self.max_strength:
@@ -286,16 +296,8 @@ class CMJND(Construction):
         return list(range(2, min(dims, self.max_strength) + 1))
 
     def nearest(self, spp, dims=None, strength=None):
-        # Only the few s around spp**(1/t) of each strength can be nearest;
-        # enumerating every count (16.7 million at t = 1) took half a minute.
-        cands = []
-        for t in self._strengths(dims, strength):
-            root = int(round(max(spp, 1) ** (1.0 / t)))
-            s_max = integer_root_floor(MAX_SPP, t)
-            for s in {*range(max(2, root - 2), root + 3), s_max}:
-                if 2 <= s <= s_max:
-                    cands.append(SppChoice(s**t, s, t, t))
-        return nearest(cands, spp)
+        return nearest(_power_candidates(spp, self._strengths(dims, strength),
+                                         lambda s, t: s >= 2, lambda s, t: t), spp)
 
     def choices(self, dims=None, strength=None):
         out = []

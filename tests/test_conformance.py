@@ -315,22 +315,28 @@ def test_largest_bush(backend, s, t):
         assert_same_bits(got, reference_block(smp, [1, U32_MAX], samples, dims), f"seed={seed} {offset}")
 
 
+def _tabled_equals_direct(smp, monkeypatch, pixels, samples=None, dims=None):
+    """Generate a block on the table path (asserting that it is taken), then with
+    tables switched off (the direct path); assert the same bits and return the block."""
+    from pyoa.request import Request
+
+    req = smp._request(pixels, samples, dims)
+    assert req.tables_pay_off(0, req.n_rows)
+    tabled = smp.generate(pixels=pixels, samples=samples, dims=dims)
+    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
+    assert_same_bits(tabled, smp.generate(pixels=pixels, samples=samples, dims=dims), "table path vs direct path")
+    return tabled
+
+
 @pytest.mark.parametrize("s, t", [(4, 3), (9, 2), (8, 3), (16, 2)])
 @pytest.mark.parametrize("offset", ["cmj", "centered"])
 def test_bush_table_and_direct_paths_agree(backend, s, t, offset, monkeypatch):
     """All samples of a few pixels (the table path) and the same values one sample
     at a time (the direct path) are the same bits, and match the reference."""
-    from pyoa.request import Request
-
     N = s**t
     smp = pyoa.sampler("bush", spp=N, dims=2 * (s + 1), strength=t, seed=99, offset=offset, backend=backend)
     pixels = [0, 7, U32_MAX]
-    req = smp._request(pixels, None, None)
-    assert req.tables_pay_off(0, req.n_rows)
-    tabled = smp.generate(pixels=pixels)
-    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
-    direct = smp.generate(pixels=pixels)
-    assert_same_bits(tabled, direct, "table path vs direct path")
+    tabled = _tabled_equals_direct(smp, monkeypatch, pixels)
     rng = np.random.default_rng(N)
     samples = sorted({0, N - 1, *map(int, rng.integers(0, N, 12))})
     assert_same_bits(tabled[:, samples], reference_block(smp, pixels, samples, range(smp.dims)), "vs reference")
@@ -425,18 +431,13 @@ def test_index2_table_path_at_the_largest_sizes(backend, name, s, offset, monkey
     halves of the array for Addelman-Kempthorne or ending at the last sample; the
     last column j = 2s and dimensions past the block. Same bits as the direct
     path, and as the reference on a subset."""
-    from pyoa.request import Request
-
     N, d = 2 * s * s, 2 * s + 1
     smp = pyoa.sampler(name, spp=N, dims=2 * d + 1, seed=12, offset=offset, backend=backend)
     n = smp._request([0], [0], None).table_entries + 3
     start = s * s - n // 2 if name == "addelman-kempthorne" else N - n
     samples = range(start, start + n)
     dims = [0, 1, s - 1, s, 2 * s - 1, 2 * s, d, 2 * d]
-    assert smp._request([U32_MAX], samples, dims).tables_pay_off(0, n)
-    tabled = smp.generate(pixels=[U32_MAX], samples=samples, dims=dims)
-    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
-    assert_same_bits(tabled, smp.generate(pixels=[U32_MAX], samples=samples, dims=dims), "table vs direct path")
+    tabled = _tabled_equals_direct(smp, monkeypatch, [U32_MAX], samples, dims)
     rng = np.random.default_rng(s)
     sub = sorted({0, n // 2, n - 1, *map(int, rng.integers(0, n, 12))})
     assert_same_bits(tabled[:, sub], reference_block(smp, [U32_MAX], [samples[k] for k in sub], dims), "vs reference")
@@ -450,18 +451,11 @@ def test_index2_table_and_direct_paths_agree(backend, name, s, offset, monkeypat
     """All samples of a few pixels (the table path: kernels generate_tabled_addelman_kempthorne
     and generate_tabled_bose_bush, NumPy's gather) and the same values with tables
     switched off (the direct path) are the same bits, and match the reference."""
-    from pyoa.request import Request
-
     N, d = 2 * s * s, 2 * s + 1
     smp = pyoa.sampler(name, spp=N, dims=d + 2, seed=99, offset=offset, backend=backend)
     pixels = [0, 7, U32_MAX]
-    req = smp._request(pixels, None, None)
-    assert req.table_entries == s + (2 * s if offset == "cmj" else 0) + 1
-    assert req.tables_pay_off(0, req.n_rows)
-    tabled = smp.generate(pixels=pixels)
-    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
-    direct = smp.generate(pixels=pixels)
-    assert_same_bits(tabled, direct, "table path vs direct path")
+    assert smp._request(pixels, None, None).table_entries == s + (2 * s if offset == "cmj" else 0) + 1
+    tabled = _tabled_equals_direct(smp, monkeypatch, pixels)
     rng = np.random.default_rng(N)
     samples = sorted({0, s * s - 1, s * s, N - 1, *map(int, rng.integers(0, N, 10))})
     assert_same_bits(tabled[:, samples], reference_block(smp, pixels, samples, range(smp.dims)), "vs reference")

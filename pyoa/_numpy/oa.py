@@ -10,6 +10,8 @@ NumPy backend's table path (:mod:`.backend`) reuses them.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from .. import gf
@@ -23,6 +25,13 @@ def column_key(p, j, dmax: int) -> np.ndarray:
     SUBSTRATUM_KEY and JITTER_KEY it gives the dimension seeds."""
     j = np.asarray(j, dtype=U32)
     return block_seed(p, j // U32(dmax)) * (j % U32(dmax) + U32(1))
+
+
+@lru_cache(maxsize=None)
+def field(q: int) -> "Field":
+    """The (cached) :class:`Field` of order q: its uint32 tables are built once,
+    not per chunk."""
+    return Field(q)
 
 
 class Field:
@@ -49,7 +58,7 @@ class Field:
 def bose_cell(i, col, s: int):
     """``(A_ij, A_ik)`` of Bose column ``col < s+1`` and its partner column, over GF(s)."""
     i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
-    F = Field(s)
+    F = field(s)
     S = U32(s)
     a0, a1 = i // S, i % S
     k = np.where(col % U32(2) == 1, col - U32(1), col + U32(1))
@@ -66,7 +75,7 @@ def bush_cell(i, col, s: int, t: int):
     """``(A_ij, u)`` of Bush column ``col < s+1``: the row polynomial at ``col``
     (or its leading coefficient for ``col == s``) and the sub-stratum index."""
     i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
-    F = Field(s)
+    F = field(s)
     S = U32(s)
     M = U32(s ** (t - 1))
     x = np.minimum(col, S - U32(1))  # column s evaluates nothing; keep indices in range
@@ -131,12 +140,18 @@ def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> n
     return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)
 
 
+@lru_cache(maxsize=None)
+def _ak_arrays(q: int) -> tuple[np.ndarray, ...]:
+    """:func:`pyoa.gf.ak_constants` as uint32 arrays, built once per q."""
+    return tuple(np.asarray(v, dtype=U32) for v in gf.ak_constants(q))
+
+
 def addelman_kempthorne_cell(i, col, q: int):
     """``(A_ij, u)`` of Addelman-Kempthorne column ``col < 2q+1`` (see the reference)."""
     i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
-    F = Field(q)
+    F = field(q)
     Q = U32(q)
-    kappa, b, k, c = (np.asarray(v, dtype=U32) for v in gf.ak_constants(q))
+    kappa, b, k, c = _ak_arrays(q)
     h, x, y = i // (Q * Q), (i // Q) % Q, i % Q
     x2 = F.mul(x, x)
     hq = h * Q
@@ -159,7 +174,7 @@ def addelman_kempthorne_cell(i, col, q: int):
 def bose_bush_cell(i, col, s: int):
     """``(A_ij, u)`` of Bose-Bush column ``col < 2s+1``, computed in GF(2s)."""
     i, col = np.asarray(i, dtype=U32), np.asarray(col, dtype=U32)
-    F = Field(2 * s)
+    F = field(2 * s)
     S = U32(s)
     x, k = i // S, i % S
     a = (F.mul(x, np.minimum(col, U32(2 * s - 1))) % S) ^ k

@@ -42,6 +42,16 @@ def _check_common(i: int, N: int, j: int, p: int, offset: str, jitter: float) ->
     return f32(jitter)
 
 
+def _column(i: int, N: int, j: int, dmax: int, p: int, offset: str, jitter: float):
+    """Checks the arguments, then applies the block rule (SPEC section 6):
+    dimension ``j`` is column ``j % dmax`` of the copy with seed
+    ``block_seed(p, j // dmax)``. Returns the float32 jitter amount, the
+    column and its three seeds (stratum, sub-stratum, jitter)."""
+    J = _check_common(i, N, j, p, offset, jitter)
+    block, col = divmod(j, dmax)
+    return J, col, dimension_seeds(block_seed(p, block), col)
+
+
 def _centered(M: int) -> float:
     # (M-1)/2 is an integer or a half-integer below 2**23: exact in float32.
     return (M - 1) / 2
@@ -86,10 +96,7 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
     """
     if not gf.is_supported(s):
         raise ValueError(f"bose needs s prime or a prime power <= {gf.MAX_TABLE_Q}, got s={s}")
-    J = _check_common(i, s * s, j, p, offset, jitter)
-    block, j = divmod(j, s + 1)
-    p = block_seed(p, block)
-    P1, P2, P3 = dimension_seeds(p, j)
+    J, j, (P1, P2, P3) = _column(i, s * s, j, s + 1, p, offset, jitter)
 
     a0, a1 = i // s, i % s
     if j == 0:
@@ -132,10 +139,7 @@ def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: f
     if s < 2 or t < 1:
         raise ValueError(f"cmjnd needs s >= 2 and t >= 1, got s={s}, t={t}")
     N = s**t
-    J = _check_common(i, N, j, p, offset, jitter)
-    block, j = divmod(j, t)
-    p = block_seed(p, block)
-    P1, P2, P3 = dimension_seeds(p, j)
+    J, j, (P1, P2, P3) = _column(i, N, j, t, p, offset, jitter)
 
     M = N // s
     sj = s**j
@@ -189,10 +193,7 @@ def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: fl
     if not gf.is_supported(s) or not 2 <= t <= s:
         raise ValueError(f"bush needs s prime or a prime power <= {gf.MAX_TABLE_Q} and 2 <= t <= s, got s={s}, t={t}")
     N = s**t
-    J = _check_common(i, N, j, p, offset, jitter)
-    block, j = divmod(j, s + 1)
-    p = block_seed(p, block)
-    P1, P2, P3 = dimension_seeds(p, j)
+    J, j, (P1, P2, P3) = _column(i, N, j, s + 1, p, offset, jitter)
 
     M = N // s
     c = [(i // s**l) % s for l in range(t)]
@@ -246,10 +247,7 @@ def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jit
     if pr is None or pr[0] == 2 or not gf.is_supported(q):
         raise ValueError(f"addelman-kempthorne needs q an odd prime, or odd prime power <= {gf.MAX_TABLE_Q}, got {q}")
     N = 2 * q * q
-    J = _check_common(i, N, j, p, offset, jitter)
-    block, j = divmod(j, 2 * q + 1)
-    p = block_seed(p, block)
-    P1, P2, P3 = dimension_seeds(p, j)
+    J, j, (P1, P2, P3) = _column(i, N, j, 2 * q + 1, p, offset, jitter)
 
     kappa, b, k, c = gf.ak_constants(q)
     h, x, y = i // (q * q), (i // q) % q, i % q
@@ -302,10 +300,7 @@ def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float
     if s < 2 or s & (s - 1) or 2 * s > gf.MAX_TABLE_Q:
         raise ValueError(f"bose-bush needs s a power of two with 2 <= s <= {gf.MAX_TABLE_Q // 2}, got {s}")
     N = 2 * s * s
-    J = _check_common(i, N, j, p, offset, jitter)
-    block, j = divmod(j, 2 * s + 1)
-    p = block_seed(p, block)
-    P1, P2, P3 = dimension_seeds(p, j)
+    J, j, (P1, P2, P3) = _column(i, N, j, 2 * s + 1, p, offset, jitter)
 
     x, k = i // s, i % s
     if j < 2 * s:

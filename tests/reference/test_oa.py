@@ -312,19 +312,26 @@ def test_integer_mod_q_is_not_an_oa_for_prime_powers(q):
         assert_oa(A, q, 2)
 
 
-def _bose_mod_s(i, j, s, p, offset, jitter):
-    """The pre-GF Bose value (SPEC section 5, prime s), written with plain mod-s
-    integers and pyoa's hash and float primitives only."""
-    block, j = divmod(j, s + 1)
+def _bose_from_symbols(i, j, q, p, offset, jitter, symbol, partner):
+    """SPEC section 5 Bose value from independently computed symbols: ``symbol``
+    and ``partner`` give A_ij and A_ik of column ``j < q+1``; seeds, offsets and
+    floats use pyoa's hash and float primitives only."""
+    block, j = divmod(j, q + 1)
     P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
-    aij, aik = bose_symbol(i, j, s), bose_partner_symbol(i, j, s)
-    stratum = ref.permute(aij, s, P1)
+    aij, aik = symbol(i, j), partner(i, j)
+    stratum = ref.permute(aij, q, P1)
     if offset == "centered":
-        sub = (s - 1) / 2
+        sub = (q - 1) / 2
     else:
-        seed = {"j": (aik * s + aij + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
-        sub = ref.permute(aik, s, seed)
-    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), s, s)
+        seed = {"j": (aik * q + aij + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
+        sub = ref.permute(aik, q, seed)
+    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), q, q)
+
+
+def _bose_mod_s(i, j, s, p, offset, jitter):
+    """The pre-GF Bose value (SPEC section 5, prime s), with plain mod-s integers."""
+    return _bose_from_symbols(i, j, s, p, offset, jitter,
+                              lambda i, j: bose_symbol(i, j, s), lambda i, j: bose_partner_symbol(i, j, s))
 
 
 @pytest.mark.parametrize("s", [2, 3, 5, 7, 13, 31, 251, 257, 4093])
@@ -345,16 +352,8 @@ def test_prime_bose_is_unchanged_by_gf(s):
 def _gf_bose_from_spec(i, j, q, p, offset, jitter):
     """SPEC section 5 "Bose over GF(q)", with the independent field of tests.helpers."""
     F = field_for(q)
-    block, j = divmod(j, q + 1)
-    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
-    aij, aik = gf_bose_symbol(i, j, F), gf_bose_partner_symbol(i, j, F)
-    stratum = ref.permute(aij, q, P1)
-    if offset == "centered":
-        sub = (q - 1) / 2
-    else:
-        seed = {"j": (aik * q + aij + 1) * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset] & U32_MAX
-        sub = ref.permute(aik, q, seed)
-    return sample_value(stratum, sub, jitter_value(ref.randfloat(i, P3), float(np.float32(jitter))), q, q)
+    return _bose_from_symbols(i, j, q, p, offset, jitter,
+                              lambda i, j: gf_bose_symbol(i, j, F), lambda i, j: gf_bose_partner_symbol(i, j, F))
 
 
 def _bush_from_spec(i, j, s, t, p, offset, jitter):
