@@ -7,4 +7,4 @@
 """
 
 #: The kernel sources in dependency order.
-SOURCES = ("hashes.cl", "floats.cl", "gf.cl", "oa.cl", "generate.cl")
+SOURCES = ("hashes.cl", "floats.cl", "gf.cl", "oa.cl", "baselines.cl", "generate.cl")

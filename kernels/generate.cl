@@ -116,3 +116,37 @@ GENERATE_TABLED(generate_tabled_cmjnd, cmjnd_cell(i, s, powers[col], &aij, &u))
 GENERATE_TABLED(generate_tabled_addelman_kempthorne,
                 addelman_kempthorne_cell(i, col, s, gf, gf_tabled, consts, &aij, &u))
 GENERATE_TABLED(generate_tabled_bose_bush, bose_bush_cell(i, col, s, gf, gf_tabled, &aij, &u))
+
+/* The comparison samplers: one kernel each, one work-item per value. a and b
+ * are the sampler's shape arguments (Baseline.shape_args), `table` its
+ * constants (Halton's primes, Sobol's direction numbers). */
+#define GENERATE_BASELINE(NAME, EXPR)                                                   \
+__kernel void generate_##NAME(__global float *out,                                      \
+                              __global const uint *pixels,                              \
+                              __global const uint *samples,                             \
+                              __global const uint *dims,                                \
+                              const uint n_samples,                                     \
+                              const uint n_dims,                                        \
+                              const uint row0,                                          \
+                              const uint n_values,                                      \
+                              const uint seed,                                          \
+                              const uint a,                                             \
+                              const uint b,                                             \
+                              const float J,                                            \
+                              __global const uint *table)                               \
+{                                                                                       \
+    uint gid = (uint)get_global_id(0);                                                  \
+    if (gid >= n_values) return;                                                        \
+    uint row = row0 + gid / n_dims;                                                     \
+    uint j = dims[gid % n_dims];                                                        \
+    uint i = samples[row % n_samples];                                                  \
+    uint p = pixel_seed(seed, pixels[row / n_samples]);                                 \
+    out[gid] = EXPR;                                                                    \
+}
+
+GENERATE_BASELINE(random, sample_random(i, j, p))
+GENERATE_BASELINE(jittered2d, sample_jittered2d(i, j, a, b, p, J))
+GENERATE_BASELINE(cmj2d, sample_cmj2d(i, j, a, b, p, J))
+GENERATE_BASELINE(sobol02, sample_sobol02(i, j, a, p, table))
+GENERATE_BASELINE(halton, sample_halton(i, j, p, table))
+GENERATE_BASELINE(sobol, sample_sobol(i, j, p, table))

@@ -16,6 +16,7 @@ import numpy as np
 from . import OFFSETS, backends, sampler, samplers, valid_spp
 from .atomic import atomic_path
 from .backends import BackendUnavailable
+from .constructions import get
 
 FORMATS = (".npy", ".csv")
 
@@ -75,9 +76,14 @@ def cmd_samplers(args) -> int:
 
 def cmd_spp(args) -> int:
     choices = valid_spp(args.sampler, near=args.near, dims=args.dims, strength=args.strength)
-    print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
-    for c in choices[: args.limit]:
-        print(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}")
+    if get(args.sampler).family == "oa":
+        print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
+        for c in choices[: args.limit]:
+            print(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}")
+    else:  # comparison samplers: their grid (if any) instead of s and t
+        print(f"{'spp':>9s} {'grid':>11s}")
+        for c in choices[: args.limit]:
+            print(f"{c.spp:9d} {c.detail or '-':>11s}")
     if len(choices) > args.limit:
         print(f"... {len(choices) - args.limit} more (use --near N or --limit)")
     return 0
@@ -105,9 +111,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--pixels", type=int, default=1, help="number of pixels (default 1)")
     p.add_argument("--pixel0", type=int, default=0, help="first pixel index (default 0)")
     p.add_argument("--seed", type=int, default=0, help="user seed in [0, 2^32) (default 0)")
-    p.add_argument("--offset", choices=OFFSETS, default="cmj", help="offset style (default cmj)")
-    p.add_argument("--jitter", type=float, default=1.0, help="jitter amount in [0, 1] (default 1)")
-    p.add_argument("--strength", type=int, default=None, help="strength t (cmjnd)")
+    p.add_argument("--offset", choices=OFFSETS, default=None, help="offset style of OA samplers (default cmj)")
+    p.add_argument("--jitter", type=float, default=1.0,
+                   help="jitter amount in [0, 1] (OA samplers, jittered2d, cmj2d; default 1)")
+    p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
     p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="default: automatic")
     p.add_argument("--device", default=None, help="OpenCL device selector (gpu, cpu, P:D, name)")
     p.add_argument("--out", default="points.npy", help="output file, .npy or .csv (default points.npy)")

@@ -20,6 +20,7 @@ constructions form (``s*s``, ``A_ik*s + A_ij + 1``, ``s**t``) stays below
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import math
 from dataclasses import dataclass
@@ -55,15 +56,20 @@ class SppChoice(NamedTuple):
         one block is stratified into s**t cells).
     block_dims : int
         Dimensions per independently randomized block (SPEC section 6).
+    detail : str
+        For the comparison samplers, their grid (``"11x11"``, ``"2^7"``) or ``""``.
     """
 
     spp: int
     s: int
     strength: int
     block_dims: int
+    detail: str = ""
 
     def label(self) -> str:
-        """Short text such as ``"121 (s=11)"`` or ``"125 (s=5, t=3)"``."""
+        """Short text such as ``"121 (s=11)"``, ``"125 (s=5, t=3)"`` or ``"128 (2^7)"``."""
+        if self.detail or self.strength == 0:
+            return f"{self.spp} ({self.detail})" if self.detail else str(self.spp)
         if self.strength == 2:
             return f"{self.spp} (s={self.s})"
         return f"{self.spp} (s={self.s}, t={self.strength})"
@@ -74,12 +80,17 @@ class Params:
     """Resolved parameters of one sampler.
 
     ``M = N / s`` is the number of fine sub-strata inside one coarse stratum.
+    ``dims`` is the sampler's number of dimensions (0 where unknown, as in
+    :func:`valid_spp`); only some comparison samplers depend on it. For the
+    comparison samplers (:mod:`pyoa.baselines`) ``s``, ``strength`` and ``M``
+    describe their grids as documented there.
     """
 
     s: int
     strength: int
     block_dims: int
     M: int
+    dims: int = 0
 
 
 def is_prime(n: int) -> bool:
@@ -149,6 +160,10 @@ class Construction:
     name: str
     code: int
     description: str
+    #: "oa" for the orthogonal arrays, "baseline" for the comparison samplers
+    family = "oa"
+    #: the module of pyoa.reference and pyoa._numpy holding `function`
+    module = "oa"
     #: whether the integer array is computed in a Galois field (the backends
     #: then need pyoa.gf's tables for prime-power orders); see field_order
     uses_field = False
@@ -167,6 +182,12 @@ class Construction:
 
     def shape_args(self, params: Params) -> tuple[int, ...]:
         return (params.s, params.strength)
+
+    def call(self, package: str, i, j, params: Params, p, offset, jitter):
+        """Evaluate with the implementation in ``package`` (``"pyoa.reference"``
+        or ``"pyoa._numpy"``): ``function(i, j, *shape_args(params), p, offset, jitter)``."""
+        f = getattr(importlib.import_module(f"{package}.{self.module}"), self.function)
+        return f(i, j, *self.shape_args(params), p, offset, jitter)
 
     def choices(self, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
         raise NotImplementedError
@@ -395,21 +416,32 @@ class BoseBush(_Index2):
         return f"{spp} is not 2s^2 with s a power of two (<= {self.levels()[-1]}, GF(2s) tables up to {gf.MAX_TABLE_Q})"
 
 
+#: The orthogonal-array constructions.
 CONSTRUCTIONS: dict[str, Construction] = {
     c.name: c for c in (Bose(), Bush(), CMJND(), AddelmanKempthorne(), BoseBush())
 }
+
+# The comparison samplers subclass Construction, hence the import down here.
+from .baselines import BASELINES  # noqa: E402
+
+#: Every sampler: the OA constructions, then the comparison samplers.
+SAMPLERS: dict[str, Construction] = {**CONSTRUCTIONS, **BASELINES}
 
 
 def _elsewhere(this: Construction, spp: int, dims: int | None) -> str:
     """``"; 64 is valid for bush (s=4, t=3), cmjnd (s=8)"``, or ``""``."""
     found = []
-    for c in CONSTRUCTIONS.values():
-        if c is this:
+    for c in SAMPLERS.values():
+        if c is this or c.family != this.family:
             continue
-        prm = c.solve(spp, dims, None)
+        try:
+            prm = c.solve(spp, dims, None)
+        except ValueError:  # e.g. more dims than that sampler has
+            continue
         if prm is None:
             continue
-        found.append(f"{c.name} ({SppChoice(spp, prm.s, prm.strength, prm.block_dims).label()[len(str(spp)) + 2:-1]})")
+        label = SppChoice(spp, prm.s, prm.strength, prm.block_dims, getattr(c, "detail", lambda _: "")(prm)).label()
+        found.append(f"{c.name} ({label[len(str(spp)) + 2:-1]})" if label != str(spp) else c.name)
     return f"; {spp} is valid for {', '.join(found)}" if found else ""
 
 
@@ -418,9 +450,9 @@ def get(name: str) -> Construction:
     if not isinstance(name, str):
         raise TypeError(f"sampler name must be a str, got {type(name).__name__}")
     try:
-        return CONSTRUCTIONS[name.lower()]
+        return SAMPLERS[name.lower()]
     except KeyError:
-        raise ValueError(f"unknown sampler {name!r}; valid: {', '.join(CONSTRUCTIONS)}") from None
+        raise ValueError(f"unknown sampler {name!r}; valid: {', '.join(SAMPLERS)}") from None
 
 
 def valid_spp(name: str, near: int | None = None, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
@@ -441,13 +473,17 @@ def valid_spp(name: str, near: int | None = None, dims: int | None = None, stren
 
     Returns
     -------
-    list of SppChoice
-        ``(spp, s, strength, block_dims)`` tuples in increasing ``spp``.
+    sequence of SppChoice
+        ``(spp, s, strength, block_dims, detail)`` tuples in increasing
+        ``spp``. For ``random``, ``cmj2d`` and ``halton``, which accept every
+        count in ``[1, 2**24]``, a lazy sequence of all 16.7 million.
 
     Examples
     --------
     >>> [c.label() for c in valid_spp("bose", near=120)]
     ['121 (s=11)', '169 (s=13)']
+    >>> [c.label() for c in valid_spp("sobol", near=120)]
+    ['64 (2^6)', '128 (2^7)']
     """
     construction = get(name)
     if near is None:

@@ -33,7 +33,7 @@ _UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
 
 def samplers() -> dict[str, str]:
     """The sampler names :func:`sampler` accepts, each with a one-line description."""
-    return {name: c.description for name, c in constructions.CONSTRUCTIONS.items()}
+    return {name: c.description for name, c in constructions.SAMPLERS.items()}
 
 
 def _physical_memory() -> int:
@@ -110,29 +110,37 @@ def _indices(name: str, value, size: int, default) -> np.ndarray:
 
 
 class Sampler:
-    """An orthogonal-array sampler: ``x(pixel, i, j)`` for every pixel, sample and dimension.
+    """A sampler: ``x(pixel, i, j)`` for every pixel, sample and dimension.
+
+    Orthogonal-array samplers (``bose``, ``bush``, ``cmjnd``,
+    ``addelman-kempthorne``, ``bose-bush``) and the paper's comparison
+    samplers (``random``, ``jittered2d``, ``cmj2d``, ``sobol02``, ``halton``,
+    ``sobol``) share this class, its API and its bit-exactness guarantees.
 
     Create one with :func:`sampler`. Immutable and safe to share between threads.
 
     Attributes
     ----------
     name : str
-        Construction name (``"bose"``, ``"cmjnd"``).
+        Sampler name (``"bose"``, ``"sobol"``...; see :func:`samplers`).
     spp : int
         Samples per pixel, N.
     dims : int
         Number of dimensions.
     s : int
-        Coarse strata per axis.
+        Coarse strata per axis (comparison samplers: see :mod:`pyoa.baselines`).
     strength : int
-        Strength t: every t-dimensional projection of a block is stratified.
+        Strength t: every t-dimensional projection of a block is stratified
+        (2 for the padded comparison samplers, 0 for random, halton and sobol).
     block_dims : int
-        Dimensions per independently randomized block (s+1 for Bose, t for CMJND);
-        dimensions past it come from re-randomized copies (SPEC section 6).
-    offset : str
-        Offset style: ``"cmj"`` (default), ``"mj"``, ``"j"`` or ``"centered"``.
+        Dimensions per independently randomized block (s+1 for Bose, t for CMJND,
+        2 for padded samplers); dimensions past it come from re-randomized copies
+        (SPEC section 6).
+    offset : str or None
+        Offset style of an OA sampler: ``"cmj"`` (default), ``"mj"``, ``"j"`` or
+        ``"centered"``; None for the comparison samplers.
     jitter : float
-        Jitter amount in [0, 1] (as float32).
+        Jitter amount in [0, 1] (as float32); 1 for samplers without one.
     seed : int
         User seed (uint32).
     backend : str
@@ -141,7 +149,7 @@ class Sampler:
         Largest array :meth:`generate` will allocate.
     """
 
-    def __init__(self, name, *, spp, dims, seed=0, offset="cmj", jitter=1.0, strength=None,
+    def __init__(self, name, *, spp, dims, seed=0, offset=None, jitter=1.0, strength=None,
                  backend=None, device=None, max_bytes=None):
         self._construction = constructions.get(name)
         self.name = self._construction.name
@@ -150,13 +158,22 @@ class Sampler:
         self.seed = _int("seed", seed, 0, MAX_UINT32)
         if strength is not None:
             strength = _int("strength", strength, 1)
-        if not isinstance(offset, str) or offset not in OFFSETS:
+        is_oa = self._construction.family == "oa"
+        if offset is None:
+            offset = "cmj" if is_oa else None
+        elif not is_oa:
+            raise ValueError(f"offset applies to the orthogonal-array samplers only; {self.name} has none "
+                             f"(got offset={offset!r})")
+        elif not isinstance(offset, str) or offset not in OFFSETS:
             raise ValueError(f"unknown offset {offset!r}; valid: {', '.join(OFFSETS)} (default 'cmj')")
         self.offset = offset
         if isinstance(jitter, bool) or not isinstance(jitter, numbers.Real):
             raise TypeError(f"jitter must be a real number in [0, 1], got {type(jitter).__name__}")
         if not 0.0 <= float(jitter) <= 1.0:  # NaN fails too
             raise ValueError(f"jitter must be in [0, 1] (1 = full jitter, 0 = cell centres), got {jitter}")
+        if not (is_oa or self._construction.jittered) and float(jitter) != 1.0:
+            raise ValueError(f"{self.name} has no jitter amount (got jitter={jitter}); it applies to the "
+                             "orthogonal-array samplers, jittered2d and cmj2d")
         self.jitter = float(np.float32(jitter))
         self.params = self._construction.resolve(self.spp, self.dims, strength)
         self.s, self.strength, self.block_dims = self.params.s, self.params.strength, self.params.block_dims
@@ -170,6 +187,14 @@ class Sampler:
         self.device = self._backend.describe()
 
     def __repr__(self) -> str:
+        if self._construction.family != "oa":
+            c = self._construction
+            grid = c.detail(self.params)
+            return (
+                f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}"
+                f"{f', jitter={self.jitter:g}' if c.jittered else ''}{f'; grid {grid}' if grid else ''}; "
+                f"backend={self.backend!r} on {self.device})"
+            )
         return (
             f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}, "
             f"offset={self.offset!r}, jitter={self.jitter:g}; s={self.s}, strength={self.strength}, "
@@ -267,21 +292,25 @@ class Sampler:
         i = _int("i", i, 0, self.spp - 1)
         j = _int("j", j, 0, self.dims - 1)
         p = reference.pixel_seed(self.seed, pixel)
-        c = self._construction
-        return getattr(reference, c.function)(i, j, *c.shape_args(self.params), p, self.offset, self.jitter)
+        return float(self._construction.call("pyoa.reference", i, j, self.params, p, self.offset, self.jitter))
 
 
-def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str = "cmj", jitter: float = 1.0,
+def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None = None, jitter: float = 1.0,
             strength: int | None = None, backend: str | None = None, device: str | None = None,
             max_bytes: int | str | None = None) -> Sampler:
-    """Create an orthogonal-array sampler.
+    """Create a sampler: an orthogonal array or one of the paper's comparison samplers.
 
     Parameters
     ----------
     name : str
-        ``"bose"`` (strength 2, ``spp = s**2`` with s prime, s+1 dimensions per
-        block) or ``"cmjnd"`` (``spp = s**t`` for any ``s >= 2``, t dimensions
-        per block); see :func:`samplers` and :func:`valid_spp`.
+        Orthogonal arrays: ``"bose"`` (strength 2, ``spp = s**2``, s+1
+        dimensions per block), ``"bush"`` (strength t, ``spp = s**t``),
+        ``"cmjnd"`` (``spp = s**t`` for any ``s >= 2``, t dimensions per
+        block), ``"addelman-kempthorne"``, ``"bose-bush"`` (``spp = 2 s**2``).
+        Comparison samplers: ``"random"``, ``"jittered2d"``, ``"cmj2d"``,
+        ``"sobol02"`` (padded pairs), ``"halton"`` and ``"sobol"``
+        (high-dimensional, Owen-scrambled). See :func:`samplers`,
+        :func:`valid_spp` and ``docs/samplers.md``.
     spp : int
         Samples per pixel. An invalid count raises a ValueError naming the
         nearest valid ones.
@@ -291,15 +320,18 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str = "cmj
     seed : int
         User seed in ``[0, 2**32)``; out-of-range seeds are refused, not reduced.
         Pixel ``k`` uses the array seed ``pyoa.reference.pixel_seed(seed, k)``.
-    offset : {"cmj", "mj", "j", "centered"}
-        Where points go inside their coarse strata (SPEC section 4): ``cmj``
+    offset : {"cmj", "mj", "j", "centered"}, optional
+        OA samplers only (default ``"cmj"``; the comparison samplers refuse
+        it). Where points go inside their coarse strata (SPEC section 4): ``cmj``
         (correlated multi-jittered, the paper's "Ours") and ``mj`` are 1D Latin
         hypercubes; ``j`` jitters each coarse cell independently; ``centered``
         puts every point at the centre of its coarse stratum (up to jitter).
     jitter : float
         Jitter amount in [0, 1]: 1 = uniform in the fine cell, 0 = its centre.
+        OA samplers, ``jittered2d`` and ``cmj2d`` only (the others refuse
+        anything but 1).
     strength : int, optional
-        ``cmjnd`` only: t, so ``spp = s**t``. Default: the largest
+        ``bush`` and ``cmjnd``: t, so ``spp = s**t``. Default: the largest
         ``t <= dims`` (``t >= 2``) for which ``spp`` is a perfect t-th power.
     backend : {"opencl", "numpy"}, optional
         Default: ``$PYOA_BACKEND``, else OpenCL if usable, else NumPy with a

@@ -227,12 +227,13 @@ def test_addelman_kempthorne_kernel_constants_layout():
     prm = bb.resolve(32, None, None)
     assert bb.constants(prm) == [] and bb.field_order(prm) == 8 and bb.shape_args(prm) == (4,)
     assert bb.function == "bose_bush" and constructions.get("addelman-kempthorne").function == "addelman_kempthorne"
-    assert len({c.code for c in constructions.CONSTRUCTIONS.values()}) == len(constructions.CONSTRUCTIONS)
+    assert len({c.code for c in constructions.SAMPLERS.values()}) == len(constructions.SAMPLERS)
 
 
 def test_samplers_listing():
     names = pyoa.samplers()
-    assert set(names) == {"bose", "bush", "cmjnd", "addelman-kempthorne", "bose-bush"}
+    assert set(names) == {"bose", "bush", "cmjnd", "addelman-kempthorne", "bose-bush",
+                          "random", "jittered2d", "cmj2d", "sobol02", "halton", "sobol"}
     assert all(isinstance(v, str) and v for v in names.values())
 
 
@@ -253,8 +254,8 @@ def test_valid_spp():
     assert cubes[1].label() == "27 (s=3, t=3)"
     two = pyoa.valid_spp("cmjnd", dims=2)
     assert {c.strength for c in two} == {2} and two[-1].spp == 4096**2
-    with pytest.raises(ValueError, match="unknown sampler 'sobol'"):
-        pyoa.valid_spp("sobol")
+    with pytest.raises(ValueError, match="unknown sampler 'faure'"):
+        pyoa.valid_spp("faure")
 
 
 # ----------------------------------------------------------------------------- order and chunk independence
@@ -481,7 +482,7 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="bose", spp=121, seed=True), TypeError, ["seed"]),
     (dict(name="bose", spp=121, seed="7"), TypeError, ["seed"]),
     (dict(name="bose", spp=121, offset="foo"), ValueError, ["offset", "'foo'", "cmj", "centered"]),
-    (dict(name="bose", spp=121, offset=None), ValueError, ["offset"]),
+    (dict(name="bose", spp=121, offset=3), ValueError, ["offset"]),
     (dict(name="bose", spp=121, jitter=-0.1), ValueError, ["jitter", "[0, 1]"]),
     (dict(name="bose", spp=121, jitter=1.0000001), ValueError, ["jitter"]),
     (dict(name="bose", spp=121, jitter=float("nan")), ValueError, ["jitter", "nan"]),
@@ -489,7 +490,7 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="bose", spp=121, jitter="0.5"), TypeError, ["jitter"]),
     (dict(name="bose", spp=121, jitter=None), TypeError, ["jitter"]),
     (dict(name="bose", spp=121, jitter=True), TypeError, ["jitter"]),
-    (dict(name="sobol", spp=121), ValueError, ["sobol", "bose", "cmjnd"]),
+    (dict(name="faure", spp=121), ValueError, ["faure", "bose", "cmjnd", "sobol02"]),
     (dict(name=3, spp=121), TypeError, ["name"]),
     (dict(name="bose", spp=121, backend="cuda"), ValueError, ["cuda", "opencl", "numpy"]),
     (dict(name="bose", spp=121, backend=1), TypeError, ["backend"]),

@@ -43,8 +43,7 @@ class NumpyBackend:
             out[...] = self._tabled(req, rows, i)
             return
         p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
-        c = req.construction
-        out[...] = getattr(oa, c.function)(i, req.dims[None, :], *c.shape_args(prm), p, req.offset, req.jitter)
+        out[...] = req.construction.call("pyoa._numpy", i, req.dims[None, :], prm, p, req.offset, req.jitter)
 
     @staticmethod
     def _tabled(req: Request, rows: np.ndarray, i: np.ndarray) -> np.ndarray:

@@ -47,14 +47,17 @@ class OpenCLBackend:
         return self.info.describe()
 
     def _constants(self, req: Request):
-        """Buffer of the construction's constants (Addelman-Kempthorne's), uploaded
-        once per (construction, s); a 1-element placeholder when there are none.
-        Called with self._lock held."""
-        key = (req.construction.name, req.params.s)
+        """Buffer of the sampler's constants (Addelman-Kempthorne's, Halton's
+        primes, Sobol's direction numbers), uploaded once per (sampler,
+        parameters); a 1-element placeholder when there are none. Called with
+        self._lock held."""
+        key = (req.construction.name, req.params)
         if key not in self._consts:
             import pyopencl as cl
 
-            values = np.array(req.construction.constants(req.params) or [0], dtype=np.uint32)
+            values = np.ascontiguousarray(req.construction.constants(req.params), dtype=np.uint32).ravel()
+            if values.size == 0:
+                values = np.zeros(1, np.uint32)
             self._consts[key] = cl.Buffer(self.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR,
                                           hostbuf=values)
         return self._consts[key]
@@ -91,6 +94,17 @@ class OpenCLBackend:
             # Only the pixels of these rows travel to the device.
             pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
             pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
+            if req.construction.family == "baseline":
+                a, b = (*req.construction.shape_args(prm), 0, 0)[:2]
+                self._kernels[f"generate_{req.construction.function}"](
+                    self.queue, (_padded(n_values),), (GROUP_SIZE,),
+                    buf, pixels, samples, dims,
+                    np.uint32(n_s), np.uint32(req.n_dims), np.uint32(row0 - pix0 * n_s), np.uint32(n_values),
+                    np.uint32(req.seed), np.uint32(a), np.uint32(b), np.float32(req.jitter), self._constants(req),
+                )
+                cl.enqueue_copy(self.queue, out, buf)
+                self.queue.finish()
+                return
             gf_args = (*self._field(req.construction.field_order(prm)), self._constants(req))
             if req.tables_pay_off(row0, row1):
                 E = req.table_entries

@@ -25,7 +25,7 @@ _cache: dict[int, tuple] = {}
 def defines() -> list[str]:
     """``-D`` options carrying the Python-side integer codes into the kernels."""
     opts = [f"-DOFFSET_{name.upper()}={code}" for name, code in constructions.OFFSET_CODES.items()]
-    opts += [f"-DCONSTRUCTION_{c.function.upper()}={c.code}" for c in constructions.CONSTRUCTIONS.values()]
+    opts += [f"-DCONSTRUCTION_{c.function.upper()}={c.code}" for c in constructions.SAMPLERS.values()]
     return opts
 
 

@@ -1,0 +1,114 @@
+/* The comparison samplers (mirrors pyoa/reference/baselines.py, which holds
+ * the mathematics and references). Values of random, sobol02, halton and
+ * sobol are k * 2^-24 with k a 24-bit integer: exact in float, no rounding. */
+
+#define RANDOM_KEY  0xc2b2ae35u
+#define PAD_KEY     0x85ebca6bu
+#define HALTON_KEY  0x27d4eb2fu
+#define DIGIT_KEY   0x165667b1u
+#define SOBOL_KEY   0x9e3779b9u
+#define SHUFFLE_KEY 0x51633e2du
+#define SUBX_KEY    0x68bc21ebu
+#define SUBY_KEY    0x02e5be93u
+#define JITX_KEY    0x967a889bu
+#define JITY_KEY    0x368cc8b7u
+
+float unit24(uint h) { return convert_float(h >> 8) * 0x1.0p-24f; }
+
+uint derived_seed(uint p, uint index, uint key) { return p ? hash_pair(p, index, key) : 0u; }
+
+uint reverse_bits(uint x)
+{
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/* Burley's Laine-Karras-style hash: even multipliers, so output bit k
+ * depends only on input bits <= k. */
+uint laine_karras(uint x, uint seed)
+{
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+/* Hash-based Owen scrambling of a 32-bit fraction; seed 0 = identity. */
+uint owen_scramble(uint x, uint seed)
+{
+    uint y = reverse_bits(laine_karras(reverse_bits(x), seed));
+    return seed ? y : x;
+}
+
+/* XOR of one dimension's 32 direction numbers over the set bits of g. */
+uint sobol_bits(uint g, __global const uint *v)
+{
+    uint x = 0u;
+    for (uint k = 0u; g; ++k, g >>= 1)
+        if (g & 1u) x ^= v[k];
+    return x;
+}
+
+float sample_random(uint i, uint j, uint p)
+{
+    return unit24(mix32(i ^ hash_pair(p, j, RANDOM_KEY)));
+}
+
+float sample_jittered2d(uint i, uint j, uint m, uint dims, uint p, float J)
+{
+    uint q = derived_seed(p, j >> 1, PAD_KEY);
+    uint N = m * m;
+    uint k = permute(i, N, q * SHUFFLE_KEY);
+    bool even = (j & 1u) == 0u;
+    float jit = jitter_value(randfloat(k, q * (even ? JITX_KEY : JITY_KEY)), J);
+    if (even && j + 1u == dims) return sample_value(k, 0.0f, jit, 1u, N);  /* a lone last dimension */
+    return sample_value(even ? k % m : k / m, 0.0f, jit, 1u, m);
+}
+
+float sample_cmj2d(uint i, uint j, uint m, uint n, uint p, float J)
+{
+    uint q = derived_seed(p, j >> 1, PAD_KEY);
+    uint k = permute(i, m * n, q * SHUFFLE_KEY);
+    uint sx = permute(k % m, m, q * SUBX_KEY);
+    if ((j & 1u) == 0u) {
+        uint sy = permute(k / m, n, q * SUBY_KEY);
+        return sample_value(sx, convert_float(sy), jitter_value(randfloat(k, q * JITX_KEY), J), n, m);
+    }
+    return sample_value(k / m, convert_float(sx), jitter_value(randfloat(k, q * JITY_KEY), J), m, n);
+}
+
+float sample_sobol02(uint i, uint j, uint log2n, uint p, __global const uint *directions)
+{
+    uint q = derived_seed(p, j >> 1, PAD_KEY);
+    uint g = owen_scramble(i, q * SHUFFLE_KEY) & ((1u << log2n) - 1u);
+    uint c = j & 1u;
+    return unit24(owen_scramble(sobol_bits(g, directions + 32u * c), q * (c ? JITY_KEY : JITX_KEY)));
+}
+
+float sample_halton(uint i, uint j, uint p, __global const uint *primes)
+{
+    uint b = primes[j];
+    uint q = derived_seed(p, j, HALTON_KEY);
+    uint rest = i, prefix = 0u;
+    ulong numer = 0ul, power = 1ul;  /* power = b^(k-1) */
+    while (power < 0x1000000ul) {
+        uint d = rest % b;
+        rest /= b;
+        uint dd = q ? permute(d, b, hash_pair(q, (uint)power + prefix, DIGIT_KEY)) : d;
+        numer = numer * b + dd;
+        prefix += d * (uint)power;
+        power *= b;
+    }
+    return convert_float((uint)((numer << 24) / power)) * 0x1.0p-24f;
+}
+
+float sample_sobol(uint i, uint j, uint p, __global const uint *directions)
+{
+    uint x = sobol_bits(i ^ (i >> 1), directions + 32u * j);
+    return unit24(owen_scramble(x, derived_seed(p, j, SOBOL_KEY)));
+}

@@ -1,0 +1,1 @@
+"""The NumPy fallback backend: vectorized mirrors of :mod:`pyoa.reference`."""

@@ -1,0 +1,231 @@
+"""The catalogue of comparison samplers: the paper's baselines [1]_.
+
+``random``, the padded ``jittered2d``, ``cmj2d`` and ``sobol02``, and the
+high-dimensional ``halton`` and ``sobol``: their valid sample counts, their
+parameters and their kernel codes. Each is evaluated statelessly per
+(pixel, sample, dimension) like the OA samplers; the mathematics is in
+:mod:`pyoa.reference.baselines` and ``docs/samplers.md``.
+
+References
+----------
+.. [1] W. Jarosz, A. Enayet, A. Kensler, C. Kilpatrick, P. Christensen,
+   "Orthogonal Array Sampling for Monte Carlo Rendering", EGSR 2019, Table 1.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Sequence
+
+from . import sequences
+from .constructions import MAX_DIMS, MAX_SPP, Construction, Params, SppChoice, nearest
+
+
+class AllCounts(Sequence):
+    """Every sample count ``1 .. MAX_SPP`` of a sampler that accepts any N,
+    listed lazily (16.7 million entries)."""
+
+    def __init__(self, make):
+        self._make = make
+
+    def __len__(self):
+        return MAX_SPP
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self._make(n + 1) for n in range(*k.indices(MAX_SPP))]
+        if k < 0:
+            k += MAX_SPP
+        if not 0 <= k < MAX_SPP:
+            raise IndexError(k)
+        return self._make(k + 1)
+
+
+class Baseline(Construction):
+    """Base class of the comparison samplers.
+
+    Their implementations live in ``pyoa.reference.baselines`` and
+    ``pyoa._numpy.baselines``, called as ``function(i, j, *shape_args(params),
+    p[, jitter])``, and in the kernels ``generate_{function}`` of
+    ``kernels/generate.cl``. They have no offset styles; only the samplers
+    with ``jittered = True`` take a jitter amount.
+    """
+
+    family = "baseline"
+    module = "baselines"
+    #: whether the sampler takes a jitter amount
+    jittered = False
+    #: largest number of dimensions
+    max_dims = MAX_DIMS
+    #: sample counts: "any" (1 .. 2**24), "pow2" (powers of two) or "square"
+    counts = "any"
+
+    def params(self, spp: int, dims: int | None) -> Params:
+        """Parameters for a valid ``spp`` (see the subclasses)."""
+        return Params(s=1, strength=0, block_dims=self.max_dims, M=spp, dims=dims or 0)
+
+    def detail(self, prm: Params) -> str:
+        return f"2^{prm.M.bit_length() - 1}" if self.counts == "pow2" else ""
+
+    def _choice(self, spp: int, dims=None) -> SppChoice:
+        prm = self.params(spp, dims)
+        return SppChoice(spp, prm.s, prm.strength, prm.block_dims, self.detail(prm))
+
+    def _check(self, dims, strength):
+        if strength is not None:
+            raise ValueError(f"{self.name} has no strength parameter (got strength={strength}); "
+                             "strength applies to the orthogonal-array samplers")
+        if dims is not None and dims > self.max_dims:
+            raise ValueError(f"{self.name} supports at most {self.max_dims} dimensions, got dims={dims}"
+                             f"{self.more_dims_hint}")
+
+    more_dims_hint = ""
+
+    def valid(self, spp: int) -> bool:
+        if not 1 <= spp <= MAX_SPP:
+            return False
+        return self.counts == "any" or spp & (spp - 1) == 0
+
+    def choices(self, dims=None, strength=None):
+        self._check(dims, strength)
+        if self.counts == "any":
+            return AllCounts(lambda n: self._choice(n, dims))
+        return [self._choice(1 << k, dims) for k in range(MAX_SPP.bit_length())]
+
+    def nearest(self, spp, dims=None, strength=None):
+        self._check(dims, strength)
+        if self.counts == "any":
+            near = min(max(int(spp), 1), MAX_SPP)
+            cands = [near, near + 1] if near < MAX_SPP else [near - 1, near]
+            return [self._choice(n, dims) for n in cands]
+        return nearest(self.choices(dims), spp)
+
+    def solve(self, spp, dims, strength):
+        self._check(dims, strength)
+        return self.params(spp, dims) if self.valid(spp) else None
+
+    def invalid(self, spp, dims, strength):
+        if self.counts == "pow2":
+            return f"{spp} is not a power of two in [1, 2^24]"
+        return f"{spp} is not in [1, 2^24]"
+
+    def call(self, package: str, i, j, params: Params, p, offset, jitter):
+        f = getattr(importlib.import_module(f"{package}.{self.module}"), self.function)
+        extra = (jitter,) if self.jittered else ()
+        return f(i, j, *self.shape_args(params), p, *extra)
+
+    def shape_args(self, params):
+        return ()
+
+
+class Random(Baseline):
+    """Independent uniform values, no stratification."""
+
+    name = "random"
+    code = 5
+    description = "independent uniform random values (no stratification): any N"
+
+    def params(self, spp, dims):
+        return Params(s=1, strength=0, block_dims=1, M=spp, dims=dims or 0)
+
+
+class Jittered2D(Baseline):
+    """Padded 2D jittered: each pair of dimensions an m x m jittered grid."""
+
+    name = "jittered2d"
+    code = 6
+    jittered = True
+    counts = "square"
+    description = "padded 2D jittered: N = m^2, each pair of dimensions an m x m jittered grid"
+
+    def valid(self, spp):
+        return 1 <= spp <= MAX_SPP and math.isqrt(spp) ** 2 == spp
+
+    def params(self, spp, dims):
+        m = math.isqrt(spp)
+        return Params(s=m, strength=2, block_dims=2, M=1, dims=dims or 0)
+
+    def detail(self, prm):
+        return f"{prm.s}x{prm.s}"
+
+    def choices(self, dims=None, strength=None):
+        self._check(dims, strength)
+        return [self._choice(m * m, dims) for m in range(1, math.isqrt(MAX_SPP) + 1)]
+
+    def invalid(self, spp, dims, strength):
+        return f"{spp} is not a square m^2 (m <= {math.isqrt(MAX_SPP)})"
+
+    def shape_args(self, params):
+        return (params.s, params.dims)
+
+
+class CMJ2D(Baseline):
+    """Padded correlated multi-jittered 2D (Kensler 2013): any N = m x n."""
+
+    name = "cmj2d"
+    code = 7
+    jittered = True
+    description = "padded 2D correlated multi-jittered (Kensler): any N = m x n, the most nearly square grid"
+
+    def params(self, spp, dims):
+        m = max(d for d in range(1, math.isqrt(spp) + 1) if spp % d == 0)
+        return Params(s=m, strength=2, block_dims=2, M=spp // m, dims=dims or 0)
+
+    def detail(self, prm):
+        return f"{prm.s}x{prm.M}"
+
+    def shape_args(self, params):
+        return (params.s, params.M)
+
+
+class Sobol02(Baseline):
+    """Padded (0,2)-sequence: each pair the first two Sobol dimensions, Owen-scrambled."""
+
+    name = "sobol02"
+    code = 8
+    counts = "pow2"
+    description = "padded (0,2)-sequence, Owen-scrambled and shuffled per pair: N a power of two"
+
+    def params(self, spp, dims):
+        return Params(s=2, strength=2, block_dims=2, M=spp, dims=dims or 0)
+
+    def shape_args(self, params):
+        return (params.M.bit_length() - 1,)
+
+    def constants(self, params):
+        return sequences.sobol_matrices()[:2]
+
+
+class Halton(Baseline):
+    """Owen-scrambled Halton, one prime base per dimension."""
+
+    name = "halton"
+    code = 9
+    max_dims = sequences.HALTON_MAX_DIMS
+    more_dims_hint = " (one prime base below 2^16 each); use sobol (21201) or a padded sampler for more"
+    description = f"Owen-scrambled Halton: any N, up to {sequences.HALTON_MAX_DIMS} dimensions"
+
+    def constants(self, params):
+        return sequences.primes()
+
+
+class Sobol(Baseline):
+    """Owen-scrambled Sobol (Joe-Kuo direction numbers as SciPy ships them)."""
+
+    name = "sobol"
+    code = 10
+    counts = "pow2"
+    max_dims = sequences.SOBOL_MAX_DIMS
+    more_dims_hint = " (the Joe-Kuo table); use a padded sampler for more"
+    description = (f"Owen-scrambled Sobol (Joe-Kuo directions): N a power of two, "
+                   f"up to {sequences.SOBOL_MAX_DIMS} dimensions")
+
+    def constants(self, params):
+        V = sequences.sobol_matrices()
+        return V[: params.dims] if params.dims else V
+
+
+BASELINES: dict[str, Baseline] = {
+    c.name: c for c in (Random(), Jittered2D(), CMJ2D(), Sobol02(), Halton(), Sobol())
+}
