@@ -56,6 +56,7 @@ Usage::
     python benchmarks/bench_generate.py                 # required case, both backends
     python benchmarks/bench_generate.py --quick         # fast smoke run
     python benchmarks/bench_generate.py --cases all     # every case
+    python benchmarks/bench_generate.py --cases default,baselines  # Bose and the comparison samplers
     python benchmarks/bench_generate.py --backends opencl --repeats 9
 """
 
@@ -111,7 +112,22 @@ CASES: dict[str, dict] = {
                          about="Addelman-Kempthorne q=7 (index 2), correlated multi-jittered offsets"),
     "bosebush-cmj-128x10": dict(name="bose-bush", spp=128, dims=10, offset="cmj", strength=None,
                                 about="Bose-Bush s=8 in GF(16) (index 2), correlated multi-jittered offsets"),
+    # The paper's comparison samplers, at the same or the nearest valid count.
+    "random-121x10": dict(name="random", spp=121, dims=10, offset=None, strength=None,
+                          about="independent uniform random values"),
+    "jittered2d-121x10": dict(name="jittered2d", spp=121, dims=10, offset=None, strength=None,
+                              about="padded 2D jittered, 11 x 11 per pair"),
+    "cmj2d-121x10": dict(name="cmj2d", spp=121, dims=10, offset=None, strength=None,
+                         about="padded 2D correlated multi-jittered (Kensler), 11 x 11 per pair"),
+    "sobol02-128x10": dict(name="sobol02", spp=128, dims=10, offset=None, strength=None,
+                           about="padded (0,2)-sequence, Owen-scrambled, 2^7"),
+    "halton-121x10": dict(name="halton", spp=121, dims=10, offset=None, strength=None,
+                          about="Owen-scrambled Halton, bases 2..29"),
+    "sobol-128x10": dict(name="sobol", spp=128, dims=10, offset=None, strength=None,
+                         about="Owen-scrambled Sobol (Joe-Kuo), 2^7"),
 }
+#: The comparison samplers' cases (``--cases baselines``).
+BASELINE_CASES = tuple(c for c, spec in CASES.items() if spec["offset"] is None)
 REQUIRED_CASE = "bose-cmj-121x10"
 #: The full set of cases takes about 8 minutes on a 2-core machine (NumPy
 #: dominates), over the 5-minute budget for a default run, so only the
@@ -345,8 +361,9 @@ def markdown(report: dict) -> str:
     for case in cfg["cases"]:
         spec = CASES[case]
         st = f", strength={spec['strength']}" if spec["strength"] else ""
-        lines.append(f"- `{case}`: `pyoa.sampler({spec['name']!r}, spp={spec['spp']}, dims={spec['dims']}, "
-                     f"offset={spec['offset']!r}{st})`; {spec['about']}")
+        st += f", offset={spec['offset']!r}" if spec["offset"] else ""
+        lines.append(f"- `{case}`: `pyoa.sampler({spec['name']!r}, spp={spec['spp']}, dims={spec['dims']}"
+                     f"{st})`; {spec['about']}")
     devices = {r["backend"]: r["device"] for r in report["results"] if r.get("device")}
     commit = meta["git_commit"] or "unknown"
     if meta["git_dirty"]:
@@ -412,10 +429,11 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--backends", type=_csv(BACKENDS, "backend"), default=",".join(BACKENDS),
                     help="comma-separated backends (default: opencl,numpy)")
     ap.add_argument("--cases", type=_csv(tuple(CASES), "case", extra={"all": tuple(CASES),
-                                                                       "default": DEFAULT_CASES}),
+                                                                       "default": DEFAULT_CASES,
+                                                                       "baselines": BASELINE_CASES}),
                     default="default",
-                    help=f"comma-separated case names, 'default' ({', '.join(DEFAULT_CASES)}) or 'all' "
-                         "(see --list; default: default)")
+                    help=f"comma-separated case names, 'default' ({', '.join(DEFAULT_CASES)}), "
+                         "'baselines' (the comparison samplers) or 'all' (see --list; default: default)")
     ap.add_argument("--repeats", type=int, default=5, help="timed runs after the warm-up (default: 5)")
     ap.add_argument("--pixels", type=int, default=None,
                     help=f"pixels per generate call (default: {FULL_PIXELS}; {QUICK_PIXELS} with --quick)")
