@@ -7,6 +7,7 @@
 #define HALTON_KEY  0x27d4eb2fu
 #define DIGIT_KEY   0x165667b1u
 #define SOBOL_KEY   0x9e3779b9u
+#define OWEN_KEY    0xcc9e2d51u
 #define SHUFFLE_KEY 0x51633e2du
 #define SUBX_KEY    0x68bc21ebu
 #define SUBY_KEY    0x02e5be93u
@@ -77,7 +78,7 @@ float sample_cmj2d(uint i, uint j, uint m, uint n, uint p, float J)
     uint sx = permute(k % m, m, q * SUBX_KEY);
     if ((j & 1u) == 0u) {
         uint sy = permute(k / m, n, q * SUBY_KEY);
-        return sample_value(sx, convert_float(sy), jitter_value(randfloat(k, q * JITX_KEY), J), n, m);
+        return sample_value(k % m, convert_float(sy), jitter_value(randfloat(k, q * JITX_KEY), J), n, m);
     }
     return sample_value(k / m, convert_float(sx), jitter_value(randfloat(k, q * JITY_KEY), J), m, n);
 }
@@ -85,9 +86,10 @@ float sample_cmj2d(uint i, uint j, uint m, uint n, uint p, float J)
 float sample_sobol02(uint i, uint j, uint log2n, uint p, __global const uint *directions)
 {
     uint q = derived_seed(p, j >> 1, PAD_KEY);
-    uint g = owen_scramble(i, q * SHUFFLE_KEY) & ((1u << log2n) - 1u);
+    /* hashed scramble seeds: Burley's top levels depend on a seed's low bits only */
+    uint g = owen_scramble(i, derived_seed(q, 0u, OWEN_KEY)) & ((1u << log2n) - 1u);
     uint c = j & 1u;
-    return unit24(owen_scramble(sobol_bits(g, directions + 32u * c), q * (c ? JITY_KEY : JITX_KEY)));
+    return unit24(owen_scramble(sobol_bits(g, directions + 32u * c), derived_seed(q, 1u + c, OWEN_KEY)));
 }
 
 float sample_halton(uint i, uint j, uint p, __global const uint *primes)

@@ -15,6 +15,7 @@ from ..reference.baselines import (
     HALTON_KEY,
     JITX_KEY,
     JITY_KEY,
+    OWEN_KEY,
     PAD_KEY,
     RANDOM_KEY,
     SHUFFLE_KEY,
@@ -111,7 +112,7 @@ def cmj2d(i, j, m: int, n: int, p, jitter: float = 1.0) -> np.ndarray:
     sy = permute(k // U32(m), n, q * U32(SUBY_KEY))
     even = (j & U32(1)) == 0
     jit = jitter_value(randfloat(k, q * np.where(even, U32(JITX_KEY), U32(JITY_KEY))), J)
-    x = sample_value(sx, sy.astype(F32), jit, n, m)
+    x = sample_value(k % U32(m), sy.astype(F32), jit, n, m)
     y = sample_value(k // U32(m), sx.astype(F32), jit, m, n)
     return np.where(even, x, y)
 
@@ -120,10 +121,9 @@ def sobol02(i, j, log2n: int, p) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.baselines.sobol02`."""
     i, j = _u32(i), _u32(j)
     q = derived_seed(p, j >> U32(1), PAD_KEY)
-    g = owen_scramble(i, q * U32(SHUFFLE_KEY)) & U32((1 << log2n) - 1)
-    even = (j & U32(1)) == 0
+    g = owen_scramble(i, derived_seed(q, 0, OWEN_KEY)) & U32((1 << log2n) - 1)
     x = sobol_bits(g, j & U32(1))
-    return unit24(owen_scramble(x, q * np.where(even, U32(JITX_KEY), U32(JITY_KEY))))
+    return unit24(owen_scramble(x, derived_seed(q, U32(1) + (j & U32(1)), OWEN_KEY)))
 
 
 def halton(i, j, p) -> np.ndarray:

@@ -44,6 +44,7 @@ PAD_KEY = 0x85EBCA6B
 HALTON_KEY = 0x27D4EB2F
 DIGIT_KEY = 0x165667B1
 SOBOL_KEY = 0x9E3779B9
+OWEN_KEY = 0xCC9E2D51
 #: Multipliers of Kensler's CMJ [2]_: sample shuffle, x and y sub-strata
 #: permutations, x and y jitter (the same constants as SPEC's OA seeds).
 SHUFFLE_KEY = 0x51633E2D
@@ -198,8 +199,13 @@ def cmj2d(i: int, j: int, m: int, n: int, p: int, jitter: float = 1.0) -> float:
         k  = permute(i, N, q * SHUFFLE_KEY)          # shuffled sample
         sx = permute(k mod m, m, q * SUBX_KEY)       # one permutation for all rows
         sy = permute(k // m, n, q * SUBY_KEY)        # one permutation for all columns
-        x  = (sx + (sy + jitter_x) / n) / m
+        x  = (k mod m + (sy + jitter_x) / n) / m
         y  = (k // m + (sx + jitter_y) / m) / n
+
+    The coarse cell is ``(k mod m, k // m)``; the sub-cell permutations
+    ``sx`` of the column and ``sy`` of the row place the point inside it
+    (using ``sx`` also as x's column would tie x's column to y's sub-row and
+    bias every estimate).
 
     Every pair is an ``m x n`` jittered grid (one point per cell) and both
     coordinates are 1D Latin hypercubes of ``N`` strata; a lone odd last
@@ -228,7 +234,7 @@ def cmj2d(i: int, j: int, m: int, n: int, p: int, jitter: float = 1.0) -> float:
     sx = permute(k % m, m, (q * SUBX_KEY) & MASK)
     if j % 2 == 0:
         sy = permute(k // m, n, (q * SUBY_KEY) & MASK)
-        return sample_value(sx, float(sy), jitter_value(randfloat(k, (q * JITX_KEY) & MASK), J), n, m)
+        return sample_value(k % m, float(sy), jitter_value(randfloat(k, (q * JITX_KEY) & MASK), J), n, m)
     return sample_value(k // m, float(sx), jitter_value(randfloat(k, (q * JITY_KEY) & MASK), J), m, n)
 
 
@@ -238,9 +244,14 @@ def sobol02(i: int, j: int, log2n: int, p: int) -> float:
 
     Pair ``b = j // 2`` with seed ``q = hash_pair(p, b, PAD_KEY)``::
 
-        g = owen_scramble(i, q * SHUFFLE_KEY) mod N     # nested shuffle of the order
-        x = unit24(owen_scramble(sobol_bits(g, 0), q * JITX_KEY))
-        y = unit24(owen_scramble(sobol_bits(g, 1), q * JITY_KEY))
+        g = owen_scramble(i, hash_pair(q, 0, OWEN_KEY)) mod N   # nested shuffle of the order
+        x = unit24(owen_scramble(sobol_bits(g, 0), hash_pair(q, 1, OWEN_KEY)))
+        y = unit24(owen_scramble(sobol_bits(g, 1), hash_pair(q, 2, OWEN_KEY)))
+
+    The three scramble seeds are hashed, not ``q`` times constants: the top
+    ``l`` levels of Burley's scramble depend only on the low ``l`` bits of
+    its seed, and the low bits of ``q * A`` and ``q * B`` are tied, which
+    would correlate x and y below the net's resolution.
 
     Owen scrambling the index maps every prefix ``[0, 2**k)`` onto an aligned
     block ``[c 2**k, (c+1) 2**k)`` of the sequence, which is a (0,k,2)-net;
@@ -263,9 +274,8 @@ def sobol02(i: int, j: int, log2n: int, p: int) -> float:
     N = 1 << log2n
     _check(i, N, j, p)
     q = derived_seed(p, j >> 1, PAD_KEY)
-    g = owen_scramble(i, (q * SHUFFLE_KEY) & MASK) & (N - 1)
-    key = JITX_KEY if j % 2 == 0 else JITY_KEY
-    return unit24(owen_scramble(sobol_bits(g, j & 1), (q * key) & MASK))
+    g = owen_scramble(i, derived_seed(q, 0, OWEN_KEY)) & (N - 1)
+    return unit24(owen_scramble(sobol_bits(g, j & 1), derived_seed(q, 1 + (j & 1), OWEN_KEY)))
 
 
 def _halton_digits(b: int) -> int:
