@@ -120,7 +120,15 @@ class Baseline(Construction):
 
 
 class Random(Baseline):
-    """Independent uniform values, no stratification."""
+    """``random``: independent uniform values, the paper's "Random".
+
+    Any ``spp`` in ``[1, 2**24]``, any number of dimensions. No
+    stratification: the variance of an estimate falls as ``1/N``. Values are
+    24-bit (``k * 2**-24``). Math: :func:`pyoa.reference.baselines.random`.
+
+    >>> pyoa.sampler("random", spp=100, dims=7).generate().shape   # doctest: +SKIP
+    (1, 100, 7)
+    """
 
     name = "random"
     code = 5
@@ -131,7 +139,15 @@ class Random(Baseline):
 
 
 class Jittered2D(Baseline):
-    """Padded 2D jittered: each pair of dimensions an m x m jittered grid."""
+    """``jittered2d``: padded 2D jittered sampling, the paper's "Jittered2D (pad)".
+
+    ``spp = m**2``. Dimensions ``(0, 1), (2, 3), ...`` are independent pairs,
+    each an ``m x m`` jittered grid with exactly one point per cell (its
+    sample order shuffled per pair); with an odd ``dims`` the last dimension
+    is a 1D jittered set of ``N`` strata. No 1D stratification beyond ``m``
+    strata inside a pair. ``jitter`` scales the offset inside the cell
+    (0: cell centres). Math: :func:`pyoa.reference.baselines.jittered2d`.
+    """
 
     name = "jittered2d"
     code = 6
@@ -161,7 +177,16 @@ class Jittered2D(Baseline):
 
 
 class CMJ2D(Baseline):
-    """Padded correlated multi-jittered 2D (Kensler 2013): any N = m x n."""
+    """``cmj2d``: padded correlated multi-jittered 2D (Kensler 2013), the paper's "CMJ2D (pad)".
+
+    Any ``spp``, split into the most nearly square grid ``m x n`` (``m`` the
+    largest divisor of N not above its square root: 120 = 10 x 12, a prime
+    N is 1 x N). Each pair of dimensions has one point per cell of the
+    ``m x n`` grid, and both of its coordinates are 1D Latin hypercubes of
+    ``N`` strata; pairs are independent (their own seed and sample order).
+    ``jitter`` as for :class:`Jittered2D`. Math:
+    :func:`pyoa.reference.baselines.cmj2d`.
+    """
 
     name = "cmj2d"
     code = 7
@@ -180,7 +205,15 @@ class CMJ2D(Baseline):
 
 
 class Sobol02(Baseline):
-    """Padded (0,2)-sequence: each pair the first two Sobol dimensions, Owen-scrambled."""
+    """``sobol02``: padded (0,2)-sequence, the paper's "(0,2)-seq. (pad)".
+
+    ``spp = 2**k``. Each pair of dimensions is the first two Sobol
+    dimensions, Owen-scrambled (Burley 2020) with its own seed and its
+    sample order shuffled by a nested scramble of the index, so every
+    power-of-two prefix of every pair has exactly one point in every
+    elementary interval ``2**-u x 2**-v`` with ``u + v = k``. Math:
+    :func:`pyoa.reference.baselines.sobol02`.
+    """
 
     name = "sobol02"
     code = 8
@@ -198,7 +231,15 @@ class Sobol02(Baseline):
 
 
 class Halton(Baseline):
-    """Owen-scrambled Halton, one prime base per dimension."""
+    """``halton``: Owen-scrambled Halton sequence, the paper's "Halton".
+
+    Any ``spp``; dimension ``j`` is the radical inverse in the ``j``-th prime
+    (2, 3, 5, ...), up to 6542 dimensions (the primes below ``2**16``), each
+    digit permuted by a hash of the digits before it (Owen's nested
+    scrambling), per dimension and pixel. The first ``b**k`` samples of a
+    base-``b`` dimension fall one in each of ``b**k`` intervals. Math:
+    :func:`pyoa.reference.baselines.halton`.
+    """
 
     name = "halton"
     code = 9
@@ -211,7 +252,17 @@ class Halton(Baseline):
 
 
 class Sobol(Baseline):
-    """Owen-scrambled Sobol (Joe-Kuo direction numbers as SciPy ships them)."""
+    """``sobol``: Owen-scrambled Sobol sequence, the paper's "Sobol".
+
+    ``spp = 2**k``, up to 21201 dimensions with the Joe-Kuo direction
+    numbers SciPy ships (:mod:`pyoa.sequences`), in SciPy's Gray-code order,
+    each dimension Owen-scrambled (Burley 2020) per pixel. Every power-of-two
+    prefix is a (t,m,s)-net: each dimension stratified into ``2**k``
+    intervals, dimensions 0 and 1 a (0,k,2)-net. Unscrambled (``p = 0``
+    through :mod:`pyoa.reference.baselines`) it equals
+    ``scipy.stats.qmc.Sobol(d, scramble=False)``. Math:
+    :func:`pyoa.reference.baselines.sobol`.
+    """
 
     name = "sobol"
     code = 10
