@@ -31,8 +31,10 @@ The NumPy backend needs 15-20 s per run of it, so the default run (one
 warm-up plus five timed runs on each backend) takes 2-2.5 minutes on a 2-core
 machine. ``--quick`` scales the pixel count down (to 4,096) for a smoke run
 of a few seconds; such results are marked ``quick`` and are not comparable
-with a full run. ``--cases all`` adds four more cases; that takes about
-7-8 minutes, so they are opt-in.
+with a full run. ``--cases all`` adds every other case (each OA
+construction and offset, and the comparison samplers); that takes about 15
+minutes, so they are opt-in. ``--cases baselines`` runs the six comparison
+samplers (about 6 minutes with the default case).
 
 Noise
 -----
