@@ -1,9 +1,11 @@
 """pyoa: orthogonal-array sampling for Monte Carlo rendering.
 
 Stateless, hash-based orthogonal-array samplers after Jarosz et al.,
-"Orthogonal Array Sampling for Monte Carlo Rendering" (EGSR 2019), computed
-in bulk by OpenCL kernels (PoCL by default), a NumPy fallback, or one value
-at a time by the pure-Python reference, all with the same float32 bits.
+"Orthogonal Array Sampling for Monte Carlo Rendering" (EGSR 2019), and the
+paper's comparison samplers (random, padded jittered / CMJ / (0,2), Halton,
+Sobol), computed in bulk by OpenCL kernels (PoCL by default), a NumPy
+fallback, or one value at a time by the pure-Python reference, all with the
+same float32 bits.
 
 >>> import pyoa
 >>> smp = pyoa.sampler("bose", spp=121, dims=8, seed=7)

@@ -4,7 +4,9 @@ Scalar, one value at a time, written to be read next to ``SPEC.md``. It is
 slow by design; use :func:`pyoa.sampler` for bulk generation.
 
 Public functions: :func:`permute`, :func:`randfloat`, :func:`pixel_seed`,
-:func:`block_seed`, :func:`bose`, :func:`bush`, :func:`cmjnd`.
+:func:`block_seed`, :func:`bose`, :func:`bush`, :func:`cmjnd`,
+:func:`addelman_kempthorne`, :func:`bose_bush`; the comparison samplers are
+in :mod:`pyoa.reference.baselines`.
 """
 
 from .hashes import block_seed, dimension_seeds, mix32, permute, pixel_seed, randfloat
