@@ -3,6 +3,8 @@
 ``pyoa points``   generate a point set and save it (.npy or .csv)
 ``pyoa samplers`` list the samplers, ``pyoa spp NAME`` their valid sample counts
 ``pyoa backends`` report the usable backends and OpenCL devices
+``pyoa render``   render a scene (EXR/PNG); ``pyoa compare`` tabulate samplers'
+                  relative MSE against a reference; ``pyoa reference`` render one
 """
 
 from __future__ import annotations
@@ -134,6 +136,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("backends", help="report the usable backends and OpenCL devices")
     p.set_defaults(func=cmd_backends)
+
+    from .render.commands import add_parsers
+
+    add_parsers(sub)
     return ap
 
 

@@ -1,0 +1,505 @@
+"""Scene files: a small JSON format modelled on Mitsuba 3's scene dictionaries.
+
+A scene file is one JSON object::
+
+    {
+      "description": "optional free text",
+      "camera": {"to_world": [[-1,0,0,0],[0,1,0,0],[0,0,-1,3.9],[0,0,0,1]], "fov": 39.3077,
+                 "aperture": 0.0, "focus_distance": 3.9, "motion": [0, 0, 0]},
+      "film": {"width": 256, "height": 256},
+      "integrator": {"max_depth": 5, "mis": true},
+      "materials": {"white": {"type": "diffuse", "reflectance": [0.885809, 0.698859, 0.666422]},
+                    "steel": {"type": "ggx", "specular": [0.9, 0.9, 0.9], "roughness": 0.2},
+                    "glass-mirror": {"type": "mirror", "tint": [1, 1, 1]}},
+      "shapes": [
+        {"type": "rectangle", "id": "floor", "to_world": [[...]], "material": "white"},
+        {"type": "cube", "to_world": [[...]], "material": "white"},
+        {"type": "mesh", "file": "meshes/thing.obj", "material": "white"},
+        {"type": "rectangle", "to_world": [[...]], "material": "white", "emission": [18.387, 13.9873, 6.75357]}
+      ]
+    }
+
+Conventions are Mitsuba's:
+
+* ``rectangle`` is the square [-1, 1]^2 in the z = 0 plane with normal +z (two
+  triangles, counter-clockwise seen from +z); ``cube`` is [-1, 1]^3 with
+  outward normals (12 triangles); ``mesh`` is every triangle of a file trimesh
+  can load (``file`` is relative to the scene file).
+* ``to_world`` is a row-major 4x4 affine matrix applied to column vectors
+  (default: identity). A triangle's geometric normal is
+  ``cross(v1 - v0, v2 - v0)`` of its world-space vertices; where
+  ``det(to_world[:3, :3]) < 0`` the winding of every triangle is reversed so
+  that normals keep pointing to the front (outwards).
+* ``emission`` (RGB radiance, >= 0) turns a shape into an area light that emits
+  on its front side only. A scene needs at least one emitter.
+* ``camera.fov`` is in degrees along the smaller image axis; ``aperture`` is
+  the thin-lens radius (0: pinhole); ``focus_distance`` > 0; ``motion`` is a
+  world-space translation of the camera over the shutter interval [0, 1).
+  The camera looks along its local +z with local +y up.
+* ``integrator.max_depth`` counts path segments (1: only emitters seen
+  directly, 2: direct lighting); ``integrator.mis`` (default true) false
+  means the last path vertex samples the lights only, no BSDF sample.
+* Materials: ``diffuse`` (``reflectance``, default 0.5 grey), ``ggx`` (a
+  rough conductor: ``specular`` colour, default white, and ``roughness``, the
+  GGX alpha as Mitsuba's ``alpha``, in (0, 1], default 0.1) and ``mirror``
+  (``tint``, default white). Colours are RGB in [0, 1].
+
+Every error found on load is a :class:`ValueError` whose message names the
+file and the field (``cornell.json: shapes[3].material: unknown material
+'whte'; valid: white, red, green``); a missing scene or mesh file raises
+:class:`FileNotFoundError`. Bundled scenes (the ``scenes/`` folder, shipped
+as ``pyoa.scenes``) load by name: ``load("cornell")``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from pyoa.render.bsdf import Materials
+
+__all__ = ["Camera", "Scene", "SceneError", "UnknownSceneError", "load", "bundled", "rectangle", "cube"]
+
+
+class SceneError(ValueError):
+    """An invalid scene file (message: ``file: field: problem``)."""
+
+
+class UnknownSceneError(FileNotFoundError, ValueError):
+    """A scene name that is neither a file nor a bundled scene (both a
+    :class:`FileNotFoundError` and a :class:`ValueError`)."""
+
+
+# -- data ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class Camera:
+    """A perspective (thin-lens) camera, Mitsuba's conventions."""
+
+    to_world: np.ndarray  # (4, 4) float64
+    fov: float  # degrees, along the smaller image axis
+    aperture: float  # lens radius, 0 = pinhole
+    focus_distance: float
+    motion: np.ndarray  # (3,) float64, world-space translation over the shutter
+
+    @property
+    def position(self) -> np.ndarray:
+        """Camera position at time 0."""
+        return self.to_world[:3, 3].copy()
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A loaded scene: world-space triangles and everything needed to render them."""
+
+    path: str  # the file it came from
+    name: str  # file stem
+    triangles: np.ndarray  # (T, 3, 3) float32, world space
+    normals: np.ndarray  # (T, 3) float64 unit geometric normals
+    areas: np.ndarray  # (T,) float64
+    material: np.ndarray  # (T,) int32 material id per triangle
+    emission: np.ndarray  # (T, 3) float64, 0 for non-emitters
+    materials: Materials
+    camera: Camera
+    width: int
+    height: int
+    max_depth: int
+    mis: bool
+    description: str = ""
+    shape_index: np.ndarray = field(default=None)  # (T,) int32: which entry of "shapes" made each triangle
+
+    @property
+    def emitters(self) -> np.ndarray:
+        """Indices of the emissive triangles."""
+        return np.flatnonzero(self.emission.max(axis=1) > 0)
+
+    def __repr__(self) -> str:
+        return (f"Scene({self.name!r}, {len(self.triangles)} triangles, {len(self.emitters)} emissive, "
+                f"{len(self.materials.names)} materials, {self.width}x{self.height}, "
+                f"max_depth={self.max_depth}, mis={self.mis})")
+
+
+# -- canonical shapes ------------------------------------------------------------
+
+
+def rectangle() -> np.ndarray:
+    """Mitsuba's rectangle: [-1, 1]^2 at z = 0, normal +z; (2, 3, 3) float64."""
+    v = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], dtype=np.float64)
+    return v[np.array([[0, 1, 2], [0, 2, 3]])]
+
+
+def cube() -> np.ndarray:
+    """Mitsuba's cube: [-1, 1]^3 with outward normals; (12, 3, 3) float64."""
+    faces = []
+    rect = rectangle()
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            # Map the rectangle's (x, y, z=1) frame onto the face whose outward
+            # normal is sign * e_axis, keeping the frame right-handed.
+            n = np.zeros(3)
+            n[axis] = sign
+            a = np.zeros(3)
+            a[(axis + 1) % 3] = 1.0
+            b = np.cross(n, a)
+            m = np.stack([a, b, n], axis=1)  # columns: local x, y, z
+            faces.append(rect @ m.T + n)
+    return np.concatenate(faces)
+
+
+# -- validation helpers -----------------------------------------------------------
+
+
+class _Ctx:
+    """Formats error messages as ``file: field: problem``."""
+
+    def __init__(self, filename: str):
+        self.filename = filename
+
+    def error(self, where: str, msg: str) -> SceneError:
+        return SceneError(f"{self.filename}: {where}: {msg}" if where else f"{self.filename}: {msg}")
+
+
+def _show(value) -> str:
+    try:
+        s = json.dumps(value)
+    except (TypeError, ValueError):
+        s = repr(value)
+    return s if len(s) <= 60 else s[:57] + "..."
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _check_keys(ctx: _Ctx, where: str, obj, valid: tuple[str, ...], required: tuple[str, ...] = ()):
+    if not isinstance(obj, dict):
+        raise ctx.error(where, f"expected an object, got {_show(obj)}")
+    for k in obj:
+        if k not in valid:
+            raise ctx.error(_join(where, k), f"unknown key; valid: {', '.join(valid)}")
+    for k in required:
+        if k not in obj:
+            raise ctx.error(_join(where, k), "missing (required)")
+
+
+def _join(where: str, key) -> str:
+    if isinstance(key, int):
+        return f"{where}[{key}]"
+    return f"{where}.{key}" if where else key
+
+
+def _number(ctx, where, v, lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False) -> float:
+    lb, rb = ("(" if lo_open else "["), (")" if hi_open else "]")
+    if math.isinf(lo) and math.isinf(hi):
+        want = "a finite number"
+    elif math.isinf(hi):
+        want = f"a number {'>' if lo_open else '>='} {lo:g}"
+    else:
+        want = f"a number in {lb}{lo:g}, {hi:g}{rb}"
+    if not _is_number(v) or not math.isfinite(v):
+        raise ctx.error(where, f"expected {want}, got {_show(v)}")
+    if v < lo or v > hi or (lo_open and v == lo) or (hi_open and v == hi):
+        raise ctx.error(where, f"expected {want}, got {_show(v)}")
+    return float(v)
+
+
+def _integer(ctx, where, v, lo: int) -> int:
+    if isinstance(v, bool) or not (isinstance(v, int) or (isinstance(v, float) and v.is_integer())):
+        raise ctx.error(where, f"expected an integer >= {lo}, got {_show(v)}")
+    if v < lo:
+        raise ctx.error(where, f"expected an integer >= {lo}, got {_show(v)}")
+    return int(v)
+
+
+def _boolean(ctx, where, v) -> bool:
+    if not isinstance(v, bool):
+        raise ctx.error(where, f"expected true or false, got {_show(v)}")
+    return v
+
+
+def _string(ctx, where, v) -> str:
+    if not isinstance(v, str):
+        raise ctx.error(where, f"expected a string, got {_show(v)}")
+    return v
+
+
+def _vector(ctx, where, v, n=3, lo=-math.inf, hi=math.inf) -> np.ndarray:
+    """A list of n numbers, each in [lo, hi]."""
+    if not isinstance(v, list) or len(v) != n:
+        raise ctx.error(where, f"expected a list of {n} numbers, got {_show(v)}")
+    for i, x in enumerate(v):
+        _number(ctx, _join(where, i), x, lo, hi)
+    return np.array(v, dtype=np.float64)
+
+
+def _matrix(ctx, where, v) -> np.ndarray:
+    """A row-major 4x4 affine, invertible matrix."""
+    ok = isinstance(v, list) and len(v) == 4 and all(isinstance(r, list) and len(r) == 4 for r in v)
+    if not ok:
+        raise ctx.error(where, f"expected a 4x4 matrix (a list of 4 rows of 4 numbers), got {_show(v)}")
+    for i, row in enumerate(v):
+        for j, x in enumerate(row):
+            _number(ctx, f"{where}[{i}][{j}]", x)
+    m = np.array(v, dtype=np.float64)
+    if not np.allclose(m[3], [0, 0, 0, 1], rtol=0, atol=1e-9):
+        raise ctx.error(where, f"last row must be [0, 0, 0, 1] (an affine transform), got {_show(v[3])}")
+    m[3] = [0, 0, 0, 1]
+    a = m[:3, :3]
+    scale = np.abs(a).max()
+    if scale == 0 or abs(np.linalg.det(a)) <= 1e-12 * scale**3:
+        raise ctx.error(where, "singular matrix (det of the upper-left 3x3 is 0)")
+    return m
+
+
+def _transform(tris: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Apply the affine ``m`` to (T, 3, 3) triangles, reversing the winding
+    where it mirrors."""
+    out = tris @ m[:3, :3].T + m[:3, 3]
+    if np.linalg.det(m[:3, :3]) < 0:
+        out = out[:, [0, 2, 1]]
+    return out
+
+
+# -- loading -------------------------------------------------------------------------
+
+_TOP = ("description", "camera", "film", "integrator", "materials", "shapes")
+_CAMERA = ("to_world", "fov", "aperture", "focus_distance", "motion")
+_FILM = ("width", "height")
+_INTEGRATOR = ("max_depth", "mis")
+_SHAPE = ("type", "id", "to_world", "material", "emission", "file")
+_SHAPE_TYPES = ("rectangle", "cube", "mesh")
+# material type -> (bsdf kind, {key: default}, colour key)
+_MATERIAL_TYPES = {
+    "diffuse": ("diffuse", {"reflectance": [0.5, 0.5, 0.5]}, "reflectance"),
+    "ggx": ("ggx", {"specular": [1.0, 1.0, 1.0], "roughness": 0.1}, "specular"),
+    "mirror": ("mirror", {"tint": [1.0, 1.0, 1.0]}, "tint"),
+}
+
+
+def _no_duplicates(ctx: _Ctx):
+    def hook(pairs):
+        out = {}
+        for k, v in pairs:
+            if k in out:
+                raise ctx.error("", f"duplicate key {k!r} in one object")
+            out[k] = v
+        return out
+
+    return hook
+
+
+def _reject_constant(ctx: _Ctx):
+    def hook(name):
+        raise ctx.error("", f"invalid JSON: {name} is not a number JSON allows")
+
+    return hook
+
+
+def _parse(path: Path, ctx: _Ctx) -> dict:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise ctx.error("", f"not UTF-8 text ({e})") from None
+    try:
+        data = json.loads(text, object_pairs_hook=_no_duplicates(ctx), parse_constant=_reject_constant(ctx))
+    except json.JSONDecodeError as e:
+        raise ctx.error("", f"invalid JSON at line {e.lineno}, column {e.colno}: {e.msg}") from None
+    if not isinstance(data, dict):
+        raise ctx.error("", f"expected a JSON object at the top level, got {type(data).__name__}")
+    return data
+
+
+def _camera(ctx: _Ctx, v) -> Camera:
+    _check_keys(ctx, "camera", v, _CAMERA, required=("fov",))
+    to_world = _matrix(ctx, "camera.to_world", v["to_world"]) if "to_world" in v else np.eye(4)
+    r = to_world[:3, :3]
+    if not np.allclose(r.T @ r, np.eye(3), rtol=0, atol=1e-4):
+        raise ctx.error("camera.to_world", "the upper-left 3x3 must be a rotation (orthonormal columns, no scale)")
+    fov = _number(ctx, "camera.fov", v["fov"], 0, 180, lo_open=True, hi_open=True)
+    aperture = _number(ctx, "camera.aperture", v.get("aperture", 0.0), 0)
+    if aperture > 0 and "focus_distance" not in v:
+        raise ctx.error("camera.focus_distance", "missing (required when camera.aperture > 0)")
+    focus = _number(ctx, "camera.focus_distance", v.get("focus_distance", 1.0), 0, lo_open=True)
+    motion = _vector(ctx, "camera.motion", v.get("motion", [0.0, 0.0, 0.0]))
+    return Camera(to_world=_frozen(to_world), fov=fov, aperture=aperture, focus_distance=focus,
+                  motion=_frozen(motion))
+
+
+def _materials(ctx: _Ctx, v) -> tuple[Materials, dict[str, int]]:
+    if not isinstance(v, dict):
+        raise ctx.error("materials", f"expected an object (name -> material), got {_show(v)}")
+    if not v:
+        raise ctx.error("materials", "no materials defined")
+    specs = []
+    for name, m in v.items():
+        where = f"materials.{name}"
+        if not name:
+            raise ctx.error("materials", "empty material name")
+        if not isinstance(m, dict):
+            raise ctx.error(where, f"expected an object, got {_show(m)}")
+        if "type" not in m:
+            raise ctx.error(_join(where, "type"), f"missing (required); valid: {', '.join(_MATERIAL_TYPES)}")
+        t = m["type"]
+        if t not in _MATERIAL_TYPES:
+            raise ctx.error(_join(where, "type"),
+                            f"unknown material type {_show(t)}; valid: {', '.join(_MATERIAL_TYPES)}")
+        kind, defaults, colour_key = _MATERIAL_TYPES[t]
+        _check_keys(ctx, where, m, ("type",) + tuple(defaults))
+        colour = _vector(ctx, _join(where, colour_key), m.get(colour_key, defaults[colour_key]), lo=0, hi=1)
+        alpha = 0.0
+        if "roughness" in defaults:
+            alpha = _number(ctx, _join(where, "roughness"), m.get("roughness", defaults["roughness"]), 0, 1,
+                            lo_open=True)
+        specs.append((name, kind, tuple(float(c) for c in colour), alpha))
+    ids = {name: i for i, (name, *_rest) in enumerate(specs)}
+    return Materials.build(specs), ids
+
+
+def _mesh(ctx: _Ctx, where: str, file, base: Path) -> np.ndarray:
+    import trimesh
+
+    rel = _string(ctx, where, file)
+    path = (base / rel).resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"{ctx.filename}: {where}: mesh file not found: {path}")
+    try:
+        mesh = trimesh.load(str(path), force="mesh", process=False)
+    except Exception as e:  # noqa: BLE001 - trimesh raises anything from a bad file
+        raise ctx.error(where, f"trimesh cannot load {rel!r}: {type(e).__name__}: {e}") from None
+    faces = getattr(mesh, "faces", None)
+    vertices = getattr(mesh, "vertices", None)
+    if faces is None or vertices is None or len(faces) == 0:
+        raise ctx.error(where, f"mesh {rel!r} has no triangles")
+    tris = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
+    if tris.ndim != 3 or tris.shape[1:] != (3, 3) or not np.isfinite(tris).all():
+        raise ctx.error(where, f"mesh {rel!r} has invalid vertex data")
+    return tris
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.flags.writeable = False
+    return a
+
+
+def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path):
+    if not isinstance(v, list):
+        raise ctx.error("shapes", f"expected a list of shapes, got {_show(v)}")
+    if not v:
+        raise ctx.error("shapes", "no shapes")
+    tris, mats, ems, owner = [], [], [], []
+    valid_mats = ", ".join(ids)
+    for i, s in enumerate(v):
+        where = f"shapes[{i}]"
+        _check_keys(ctx, where, s, _SHAPE, required=("type", "material"))
+        t = s["type"]
+        if t not in _SHAPE_TYPES:
+            raise ctx.error(f"{where}.type", f"unknown shape type {_show(t)}; valid: {', '.join(_SHAPE_TYPES)}")
+        if "id" in s:
+            _string(ctx, f"{where}.id", s["id"])
+        if t == "mesh":
+            if "file" not in s:
+                raise ctx.error(f"{where}.file", "missing (required for a mesh)")
+            local = _mesh(ctx, f"{where}.file", s["file"], base)
+        elif "file" in s:
+            raise ctx.error(f"{where}.file", f"only a mesh has a file, not a {t}")
+        else:
+            local = rectangle() if t == "rectangle" else cube()
+        m = _matrix(ctx, f"{where}.to_world", s["to_world"]) if "to_world" in s else np.eye(4)
+        name = s["material"]
+        if not isinstance(name, str):
+            raise ctx.error(f"{where}.material", f"expected a material name (string), got {_show(name)}")
+        if name not in ids:
+            raise ctx.error(f"{where}.material", f"unknown material {name!r}; valid: {valid_mats}")
+        emission = np.zeros(3)
+        if "emission" in s:
+            emission = _vector(ctx, f"{where}.emission", s["emission"], lo=0)
+        world = _transform(local, m)
+        cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
+        area2 = np.linalg.norm(cross, axis=1)
+        keep = area2 > 1e-12 * max(1.0, float(np.abs(world).max())) ** 2
+        if t == "mesh":
+            world = world[keep]  # a mesh may carry degenerate faces: no area, no normal
+            if len(world) == 0:
+                raise ctx.error(f"{where}.file", f"mesh {s['file']!r} has only degenerate triangles")
+        elif not keep.all():  # cannot happen with an invertible to_world
+            raise ctx.error(f"{where}.to_world", "the transform makes triangles degenerate")
+        tris.append(world)
+        mats.append(np.full(len(world), ids[name], dtype=np.int32))
+        ems.append(np.tile(emission, (len(world), 1)))
+        owner.append(np.full(len(world), i, dtype=np.int32))
+    return np.concatenate(tris), np.concatenate(mats), np.concatenate(ems), np.concatenate(owner)
+
+
+def _load_file(path: Path) -> Scene:
+    ctx = _Ctx(path.name)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path.name}: scene file not found: {path}")
+    data = _parse(path, ctx)
+    _check_keys(ctx, "", data, _TOP, required=("camera", "materials", "shapes"))
+    description = _string(ctx, "description", data.get("description", ""))
+    camera = _camera(ctx, data["camera"])
+    film = data.get("film", {})
+    _check_keys(ctx, "film", film, _FILM)
+    width = _integer(ctx, "film.width", film.get("width", 256), 1)
+    height = _integer(ctx, "film.height", film.get("height", 256), 1)
+    integ = data.get("integrator", {})
+    _check_keys(ctx, "integrator", integ, _INTEGRATOR)
+    max_depth = _integer(ctx, "integrator.max_depth", integ.get("max_depth", 5), 1)
+    mis = _boolean(ctx, "integrator.mis", integ.get("mis", True))
+    materials, ids = _materials(ctx, data["materials"])
+    world, material, emission, owner = _shapes(ctx, data["shapes"], ids, path.parent)
+    if not (emission.max(axis=1) > 0).any():
+        raise ctx.error("shapes", "no shape has a nonzero emission: nothing would be lit")
+    cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
+    length = np.linalg.norm(cross, axis=1)
+    return Scene(
+        path=str(path),
+        name=path.stem,
+        triangles=_frozen(world.astype(np.float32)),
+        normals=_frozen(cross / length[:, None]),
+        areas=_frozen(0.5 * length),
+        material=_frozen(material),
+        emission=_frozen(emission),
+        materials=materials,
+        camera=camera,
+        width=width,
+        height=height,
+        max_depth=max_depth,
+        mis=mis,
+        description=description,
+        shape_index=_frozen(owner),
+    )
+
+
+def bundled() -> dict[str, str]:
+    """Name -> path of every scene shipped in the package (``pyoa.scenes``)."""
+    root = resources.files("pyoa.scenes")
+    out = {}
+    for entry in root.iterdir():
+        if entry.name.endswith(".json") and entry.is_file():
+            out[entry.name[: -len(".json")]] = str(entry)
+    return dict(sorted(out.items()))
+
+
+def load(scene: str | os.PathLike) -> Scene:
+    """Load a scene: a path to a ``.json`` file, or the name of a bundled
+    scene (``"cornell"``, see :func:`bundled`)."""
+    if isinstance(scene, os.PathLike):
+        return _load_file(Path(scene))
+    if not isinstance(scene, str):
+        raise TypeError(f"scene must be a path or a bundled scene name, got {type(scene).__name__}")
+    p = Path(scene)
+    if p.is_file() or scene.endswith(".json") or os.sep in scene or "/" in scene:
+        return _load_file(p)
+    names = bundled()
+    if scene not in names:
+        raise UnknownSceneError(f"{scene}: no such scene file or bundled scene; bundled: {', '.join(names)}")
+    return _load_file(Path(names[scene]))
