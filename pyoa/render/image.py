@@ -56,7 +56,7 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
         raise ValueError(f"OpenImageIO cannot read {str(path)!r}: {oiio.geterror()}")
     try:
         spec = inp.spec()
-        pixels = inp.read_image(0, 0, 0, -1, "float")
+        pixels = inp.read_image("float")
     finally:
         inp.close()
     if pixels is None:
