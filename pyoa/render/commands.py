@@ -128,15 +128,28 @@ def crop_figure(path, crops, ref_crop) -> None:
     from .image import to_srgb8
 
     panels = [*crops, ("reference", None, ref_crop)]
-    fig, axes = plt.subplots(1, len(panels), figsize=(2.2 * len(panels), 2.5), squeeze=False)
+    fig, axes = plt.subplots(1, len(panels), figsize=(2.2 * len(panels), 2.8), squeeze=False, layout="constrained")
     for ax, (name, spp, img) in zip(axes[0], panels):
         ax.imshow(to_srgb8(img), interpolation="nearest")
         ax.set_title(name if spp is None else f"{name}\n{spp} spp", fontsize=9)
         ax.axis("off")
-    fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=100)
     plt.close(fig)
+
+
+#: Key of the reference passes' seeds (see pass_seed).
+REFERENCE_KEY = 0x52454631
+
+
+def pass_seed(seed: int, k: int) -> int:
+    """Sampler seed of reference pass ``k``: a hash of (seed, k), so that no
+    pass shares its scramble with a render made with a small seed (a
+    reference rendered with seeds 0, 1, ... would share its first samples
+    with ``pyoa compare --seed 0`` and flatter that sampler)."""
+    from ..reference.hashes import hash_pair
+
+    return hash_pair(seed, k, REFERENCE_KEY)
 
 
 def cmd_reference(args) -> int:
@@ -160,7 +173,7 @@ def cmd_reference(args) -> int:
     from tqdm.auto import tqdm
 
     for k in tqdm(range(done, passes), initial=done, total=passes, desc="reference passes", disable=args.quiet):
-        res = render(scene, sampler=args.sampler, spp=args.pass_spp, seed=args.seed + k,
+        res = render(scene, sampler=args.sampler, spp=args.pass_spp, seed=pass_seed(args.seed, k),
                      width=args.size[0] if args.size else None, height=args.size[1] if args.size else None,
                      max_depth=args.max_depth, filter=args.filter, backend=args.backend)
         img = res.image.astype(np.float64)
