@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""Render throughput: camera paths and rays per second on a bundled scene.
+
+What is measured
+----------------
+``pyoa.render.render.render(scene, sampler=..., spp=..., width=W, height=H,
+max_depth=D)`` (the function behind ``pyoa render``), once as a warm-up on a
+16 x 16 image (kernel build, Embree and import costs), then ``--repeats``
+timed full renders. The time covers sample generation, ray tracing and
+shading, not scene loading or image writing. Reported: median, minimum and
+maximum seconds; camera paths per second and rays per second (camera,
+continuation and shadow rays) at the median.
+
+If ``mitsuba`` is importable, the same scene is rendered by Mitsuba 3's
+``orthogonal`` sampler (LLVM backend) for a side-by-side figure; otherwise
+the report says it was skipped.
+
+Output: ``benchmarks/results/render.json`` and ``render.md`` (``--out``),
+written atomically.
+
+Usage::
+
+    python benchmarks/bench_render.py                       # cornell 256x256, depth 5, bose 121 spp
+    python benchmarks/bench_render.py --scene dof7d --spp 121 --size 128 128
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+
+import numpy as np  # noqa: E402
+
+import pyoa  # noqa: E402
+from pyoa.atomic import atomic_path  # noqa: E402
+from pyoa.render.render import render  # noqa: E402
+from pyoa.render.scene import load  # noqa: E402
+
+
+def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, repeats: int) -> dict:
+    try:
+        import mitsuba as mi
+    except ImportError:
+        return {"status": "skipped", "reason": "mitsuba is not installed (pip install mitsuba)"}
+    if scene != "cornell":
+        return {"status": "skipped", "reason": "only the cornell scene has a Mitsuba twin"}
+    mi.set_variant("llvm_ad_rgb")
+    d = mi.cornell_box()
+    d["sensor"]["sampler"] = {"type": "orthogonal", "sample_count": spp}
+    d["sensor"]["film"]["width"], d["sensor"]["film"]["height"] = width, height
+    d["integrator"] = {"type": "path", "max_depth": depth}
+    sc = mi.load_dict(d)
+    mi.render(sc, spp=spp)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        img = mi.render(sc, spp=spp)
+        np.asarray(img)  # force evaluation
+        times.append(time.perf_counter() - t0)
+    med = statistics.median(times)
+    return {"status": "ok", "version": mi.__version__, "times_s": times, "median_s": med,
+            "paths_per_s": width * height * spp / med}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scene", default="cornell")
+    ap.add_argument("--sampler", default="bose")
+    ap.add_argument("--spp", type=int, default=121)
+    ap.add_argument("--size", type=int, nargs=2, default=(256, 256))
+    ap.add_argument("--max-depth", type=int, default=5)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default=str(REPO / "benchmarks" / "results" / "render.json"))
+    args = ap.parse_args(argv)
+    scene = load(args.scene)
+    w, h = args.size
+    render(scene, sampler=args.sampler, spp=args.spp, width=16, height=16, max_depth=args.max_depth)
+    runs = []
+    for k in range(args.repeats):
+        res = render(scene, sampler=args.sampler, spp=args.spp, width=w, height=h, max_depth=args.max_depth)
+        runs.append(res)
+        print(f"run {k + 1}/{args.repeats}: {res.seconds:.2f} s, {res.paths_per_second / 1e6:.3f} M paths/s, "
+              f"{res.rays_per_second / 1e6:.3f} M rays/s", flush=True)
+    times = [r.seconds for r in runs]
+    med = statistics.median(times)
+    mid = runs[times.index(med)] if med in times else runs[0]
+    report = {
+        "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version(),
+                    "numpy": np.__version__, "pyoa": pyoa.__version__},
+        "config": {"scene": args.scene, "sampler": args.sampler, "spp": args.spp, "size": [w, h],
+                   "max_depth": args.max_depth, "repeats": args.repeats, "dims": mid.dims},
+        "times_s": times, "median_s": med, "min_s": min(times), "max_s": max(times),
+        "paths_per_s": mid.stats.paths / med, "rays_per_s": mid.stats.rays / med,
+        "rays_per_path": mid.stats.rays / mid.stats.paths,
+        "mitsuba": mitsuba_figure(args.scene, w, h, args.spp, args.max_depth, args.repeats),
+    }
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(out) as tmp:
+        tmp.write_text(json.dumps(report, indent=2) + "\n")
+    mit = report["mitsuba"]
+    mline = (f"Mitsuba {mit['version']} `orthogonal`: {mit['paths_per_s'] / 1e6:.3f} M paths/s"
+             if mit["status"] == "ok" else f"Mitsuba: {mit['status']} ({mit['reason']})")
+    md = (f"# pyoa render benchmark\n\n`{args.scene}` {w} x {h}, max depth {args.max_depth}, {args.sampler} "
+          f"{args.spp} spp ({mid.dims} dims), {args.repeats} runs after a warm-up, {os.cpu_count()} CPUs, "
+          f"{report['date_utc']}\n\n| median s | min s | max s | M paths/s | M rays/s | rays/path |\n"
+          f"|---:|---:|---:|---:|---:|---:|\n| {med:.2f} | {min(times):.2f} | {max(times):.2f} | "
+          f"{report['paths_per_s'] / 1e6:.3f} | {report['rays_per_s'] / 1e6:.3f} | {report['rays_per_path']:.2f} |\n\n"
+          f"{mline}\n")
+    with atomic_path(out.with_suffix(".md")) as tmp:
+        tmp.write_text(md)
+    print(md)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
