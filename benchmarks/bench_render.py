@@ -47,29 +47,45 @@ from pyoa.render.render import render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
 
+_MITSUBA = """
+import json, statistics, sys, time
+import numpy as np
+import mitsuba as mi
+w, h, spp, depth, repeats = map(int, sys.argv[1:6])
+mi.set_variant("llvm_ad_rgb")
+d = mi.cornell_box()
+d["sensor"]["sampler"] = {"type": "orthogonal", "sample_count": spp}
+d["sensor"]["film"]["width"], d["sensor"]["film"]["height"] = w, h
+d["integrator"] = {"type": "path", "max_depth": depth}
+sc = mi.load_dict(d)
+np.asarray(mi.render(sc, spp=spp))
+times = []
+for _ in range(repeats):
+    t0 = time.perf_counter()
+    np.asarray(mi.render(sc, spp=spp))
+    times.append(time.perf_counter() - t0)
+med = statistics.median(times)
+print(json.dumps({"status": "ok", "version": mi.__version__, "times_s": times, "median_s": med,
+                  "paths_per_s": w * h * spp / med}))
+"""
+
+
 def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, repeats: int) -> dict:
-    try:
-        import mitsuba as mi
-    except ImportError:
+    """Mitsuba 3's ``orthogonal`` sampler on its own ``cornell_box()``, in a
+    subprocess (a Dr.Jit/LLVM failure must not take this benchmark down)."""
+    import importlib.util
+    import subprocess
+
+    if importlib.util.find_spec("mitsuba") is None:
         return {"status": "skipped", "reason": "mitsuba is not installed (pip install mitsuba)"}
     if scene != "cornell":
         return {"status": "skipped", "reason": "only the cornell scene has a Mitsuba twin"}
-    mi.set_variant("llvm_ad_rgb")
-    d = mi.cornell_box()
-    d["sensor"]["sampler"] = {"type": "orthogonal", "sample_count": spp}
-    d["sensor"]["film"]["width"], d["sensor"]["film"]["height"] = width, height
-    d["integrator"] = {"type": "path", "max_depth": depth}
-    sc = mi.load_dict(d)
-    mi.render(sc, spp=spp)
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        img = mi.render(sc, spp=spp)
-        np.asarray(img)  # force evaluation
-        times.append(time.perf_counter() - t0)
-    med = statistics.median(times)
-    return {"status": "ok", "version": mi.__version__, "times_s": times, "median_s": med,
-            "paths_per_s": width * height * spp / med}
+    proc = subprocess.run([sys.executable, "-c", _MITSUBA, str(width), str(height), str(spp), str(depth),
+                           str(repeats)], capture_output=True, text=True)
+    if proc.returncode != 0:
+        tail = (proc.stderr or proc.stdout).strip().splitlines()
+        return {"status": "failed", "reason": f"exit {proc.returncode}: {tail[0] if tail else ''}"[:300]}
+    return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
 def main(argv=None) -> int:
