@@ -212,10 +212,16 @@ class Integrator:
                 pdf_l = pdf_area * dist**2 / np.maximum(cos_q, 1e-12)
                 ok = (cos_q > 0) & np.any(f_cos > 0, axis=1)
                 if np.any(ok):
-                    s, wi, dist, f_cos, pdf_b, pdf_l, etri = (
-                        a[ok] for a in (s, wi, dist, f_cos, pdf_b, pdf_l, etri))
-                    off = self._eps * np.where((dot(wi, ns[s]) > 0)[:, None], ns[s], -ns[s])
-                    vis = self._visible(p[s] + off, wi, dist * (1 - 1e-4) - self._eps)
+                    s, wi, f_cos, pdf_b, pdf_l, etri, q, nq = (
+                        a[ok] for a in (s, wi, f_cos, pdf_b, pdf_l, etri, q, nq))
+                    # The shadow ray runs between the two points, each moved off its
+                    # surface (towards the other): from p + eps n to q + eps n_q.
+                    # Measuring it from p instead let it reach the light's own
+                    # plane and count the light as its own occluder.
+                    start = p[s] + self._eps * np.where((dot(wi, ns[s]) > 0)[:, None], ns[s], -ns[s])
+                    seg = q + self._eps * nq - start
+                    seg_len = np.linalg.norm(seg, axis=1)
+                    vis = self._visible(start, seg / np.maximum(seg_len, 1e-12)[:, None], seg_len * (1 - 1e-4))
                     stats.rays += len(s)
                     w = pdf_l**2 / (pdf_l**2 + pdf_b**2) if L.mis else np.ones(len(s))
                     contrib = beta[s] * f_cos * sc.emission[etri] * (w / pdf_l)[:, None]

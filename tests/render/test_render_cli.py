@@ -1,0 +1,341 @@
+"""The renderer's command line: ``pyoa render``, ``pyoa compare``, ``pyoa reference``
+(:mod:`pyoa.render.commands`), run in-process through :func:`pyoa.cli.main`."""
+
+from __future__ import annotations
+
+import csv
+import os
+import re
+
+import numpy as np
+import pytest
+
+from pyoa.cli import main
+from pyoa.render import commands
+from pyoa.render import image as image_mod
+from pyoa.render.image import read_image, rel_mse, write_exr
+from pyoa.render.render import render
+from pyoa.render.scene import load
+
+
+def run_error(capsys, argv) -> str:
+    """Run ``pyoa argv`` expecting exit status 2; return its stderr."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert f"pyoa {argv[0]}: error:" in err or "usage:" in err
+    return err
+
+
+def listing(path):
+    return sorted(os.listdir(path))
+
+
+# -- pyoa render ----------------------------------------------------------------------
+
+
+def test_render_writes_exr_and_png(tmp_path, capsys):
+    out, png = tmp_path / "x.exr", tmp_path / "x.png"
+    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "--png", str(png),
+                 "-q"]) == 0
+    assert capsys.readouterr().out == ""  # -q: nothing but results, and there are none
+    img = read_image(out)
+    assert img.shape == (16, 16, 3) and img.dtype == np.float32
+    assert np.all(np.isfinite(img)) and img.mean() > 0
+    # the EXR holds exactly the render (default sampler bose, seed 0)
+    want = render(load("cornell"), sampler="bose", spp=4, seed=0, width=16, height=16).image
+    np.testing.assert_array_equal(img, want)
+    # the PNG: 8-bit sRGB of the same image
+    p = read_image(png)
+    assert p.shape == (16, 16, 3)
+    np.testing.assert_array_equal(np.round(p * 255).astype(np.uint8), image_mod.to_srgb8(want))
+    assert listing(tmp_path) == ["x.exr", "x.png"]  # no temporary files left
+
+
+def test_render_non_square_size_and_options(tmp_path, capsys):
+    out = tmp_path / "r.exr"
+    assert main(["render", "dof7d", "--size", "12", "8", "--spp", "8", "--sampler", "sobol", "--seed", "3",
+                 "--max-depth", "2", "--filter", "gaussian", "--first", "light1", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "dof7d: 12 x 8, sobol 8 spp, 7 dims (0:light1.u, 1:light1.v, 2:pixel.x" in text
+    assert str(out) in text
+    want = render(load("dof7d"), sampler="sobol", spp=8, seed=3, width=12, height=8, max_depth=2,
+                  filter="gaussian", first=["light1"]).image
+    np.testing.assert_array_equal(read_image(out), want)
+
+
+def test_render_reference_prints_relmse(tmp_path, capsys):
+    ref_path, out = tmp_path / "ref.exr", tmp_path / "x.exr"
+    ref = render(load("cornell"), sampler="sobol", spp=16, seed=9, width=16, height=16).image
+    write_exr(ref_path, ref)
+    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "-q",
+                 "--reference", str(ref_path), "--crop", "4", "4", "8", "8"]) == 0
+    line = capsys.readouterr().out.strip()
+    m = re.fullmatch(r"relMSE (\S+), crop (\S+)", line)
+    assert m, line
+    img = read_image(out)
+    assert float(m.group(1)) == pytest.approx(rel_mse(img, ref), rel=1e-5)
+    assert float(m.group(2)) == pytest.approx(rel_mse(img, ref, (4, 4, 8, 8)), rel=1e-5)
+    assert float(m.group(1)) > 0
+    # against itself: 0
+    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(tmp_path / "y.exr"), "-q",
+                 "--reference", str(out)]) == 0
+    assert capsys.readouterr().out.strip() == "relMSE 0"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["render", "nosuchscene"], r"nosuchscene: no such scene file or bundled scene; bundled: .*cornell"),
+    (["render", "cornell", "--sampler", "nosuchsampler", "--spp", "4"], r"nosuchsampler"),
+    (["render", "cornell", "--sampler", "bose", "--spp", "10"], r"bose: 10 is not .*nearest: 4 \(s=2\), 9"),
+    (["render", "cornell", "--sampler", "sobol", "--spp", "12"], r"12"),
+    (["render", "cornell", "--first", "light9"], r"unknown integrand dimension 'light9'; valid: pixel\.x"),
+    (["render", "cornell", "--max-depth", "0"], r"max_depth"),
+    (["render", "missing/scene.json"], r"scene file not found"),
+])
+def test_render_errors(tmp_path, capsys, argv, message):
+    out = tmp_path / "x.exr"
+    err = run_error(capsys, [*argv, "--size", "8", "8", "--out", str(out), "-q"])
+    assert re.search(message, err), err
+    assert not out.exists()
+
+
+def test_render_reference_of_the_wrong_size(tmp_path, capsys):
+    ref = tmp_path / "ref.exr"
+    write_exr(ref, np.ones((8, 12, 3), dtype=np.float32))
+    err = run_error(capsys, ["render", "cornell", "--size", "16", "16", "--spp", "4", "--out",
+                             str(tmp_path / "x.exr"), "-q", "--reference", str(ref)])
+    assert "is 12 x 8, the render is 16 x 16; render with --size 12 8" in err
+    err = run_error(capsys, ["render", "cornell", "--size", "16", "16", "--spp", "4", "--out",
+                             str(tmp_path / "x.exr"), "-q", "--reference", str(tmp_path / "none.exr")])
+    assert "no such image" in err
+
+
+@pytest.mark.parametrize("crop", [["10", "10", "8", "8"], ["0", "0", "0", "4"], ["-1", "0", "4", "4"],
+                                  ["0", "0", "17", "1"]])
+def test_render_crop_outside_the_image(tmp_path, capsys, crop):
+    ref = tmp_path / "ref.exr"
+    write_exr(ref, np.ones((16, 16, 3), dtype=np.float32))
+    err = run_error(capsys, ["render", "cornell", "--size", "16", "16", "--spp", "4", "--out",
+                             str(tmp_path / "x.exr"), "-q", "--reference", str(ref), "--crop", *crop])
+    assert f"crop {' '.join(crop)} does not fit in the 16 x 16 image" in err
+
+
+def test_render_failure_leaves_the_output_untouched(tmp_path, monkeypatch):
+    out, png = tmp_path / "x.exr", tmp_path / "x.png"
+    out.write_bytes(b"previous exr")
+    png.write_bytes(b"previous png")
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("render failed")
+
+    monkeypatch.setattr(commands, "render", boom)
+    with pytest.raises(RuntimeError, match="render failed"):
+        main(["render", "cornell", "--size", "8", "8", "--spp", "4", "--out", str(out), "--png", str(png), "-q"])
+    assert out.read_bytes() == b"previous exr" and png.read_bytes() == b"previous png"
+    assert listing(tmp_path) == ["x.exr", "x.png"]
+
+
+def test_failed_image_write_is_atomic(tmp_path, monkeypatch):
+    """OpenImageIO failing half-way through: the old file stays, no temporary is left."""
+    out = tmp_path / "x.exr"
+    out.write_bytes(b"previous exr")
+    real = image_mod._oiio()
+
+    class FailingOutput:
+        def __init__(self):
+            self.path = None
+
+        def open(self, path, spec):
+            self.path = path
+            with open(path, "wb") as fh:
+                fh.write(b"half an image")
+            return True
+
+        def write_image(self, pixels):
+            return False
+
+        def close(self):
+            return True
+
+        def geterror(self):
+            return "disk full"
+
+    class FakeOIIO:
+        ImageSpec = real.ImageSpec
+
+        class ImageOutput:
+            @staticmethod
+            def create(path):
+                return FailingOutput()
+
+        @staticmethod
+        def geterror():
+            return ""
+
+    monkeypatch.setattr(image_mod, "_oiio", lambda: FakeOIIO)
+    with pytest.raises(OSError, match="disk full"):
+        main(["render", "cornell", "--size", "8", "8", "--spp", "4", "--out", str(out), "-q"])
+    assert out.read_bytes() == b"previous exr"
+    assert listing(tmp_path) == ["x.exr"]
+
+
+# -- pyoa compare -----------------------------------------------------------------------
+
+
+@pytest.fixture
+def reference16(tmp_path):
+    path = tmp_path / "ref.exr"
+    write_exr(path, render(load("cornell"), sampler="sobol", spp=64, seed=5, width=16, height=16).image)
+    return path
+
+
+def test_compare(tmp_path, capsys, reference16):
+    stem = tmp_path / "cmp"
+    assert main(["compare", "cornell", "--size", "16", "16", "--spp", "12", "--samplers", "random, bose,sobol",
+                 "--reference", str(reference16), "--out", str(stem), "-q"]) == 0
+    printed = capsys.readouterr().out
+    md = (tmp_path / "cmp.md").read_text()
+    assert md in printed
+    with open(tmp_path / "cmp.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["sampler"] for r in rows] == ["random", "bose", "sobol"]
+    # bose: 9 or 16 are valid, 9 is nearer 12; sobol: 8 and 16 are equally near, ties go to fewer
+    assert [int(r["spp"]) for r in rows] == [12, 9, 8]
+    assert [r["note"] for r in rows] == ["", "nearest valid to 12", "nearest valid to 12"]
+    ref = read_image(reference16)
+    for r in rows:
+        img = render(load("cornell"), sampler=r["sampler"], spp=int(r["spp"]), seed=0, width=16, height=16).image
+        assert float(r["relmse"]) == pytest.approx(rel_mse(img, ref), rel=1e-9)
+        # default crop: the quarter-size window at (W/4, H/4)
+        assert float(r["relmse_crop"]) == pytest.approx(rel_mse(img, ref, (4, 4, 4, 4)), rel=1e-9)
+        assert float(r["seconds"]) >= 0
+    lines = [ln for ln in md.splitlines() if ln.startswith("| ")]
+    assert lines[0].startswith("| sampler | spp | relMSE (image) | relMSE (crop 4x4 at 4,4) | note |")
+    assert len(lines) == 1 + 3
+    assert lines[2].startswith("| bose | 9 |") and lines[2].endswith("| nearest valid to 12 |")
+    assert lines[1].startswith("| random | 12 |") and lines[1].endswith("|  |")
+    fig = read_image(tmp_path / "cmp.png")
+    assert fig.ndim == 3 and fig.shape[0] > 50 and fig.shape[1] > fig.shape[0]
+    assert sorted(os.listdir(tmp_path)) == ["cmp.csv", "cmp.md", "cmp.png", "ref.exr"]
+
+
+def test_compare_crop_and_errors(tmp_path, capsys, reference16):
+    stem = tmp_path / "cmp"
+    assert main(["compare", "cornell", "--size", "16", "16", "--spp", "4", "--samplers", "bose",
+                 "--reference", str(reference16), "--out", str(stem), "--crop", "0", "8", "16", "8", "-q"]) == 0
+    capsys.readouterr()
+    assert "relMSE (crop 16x8 at 0,8)" in (tmp_path / "cmp.md").read_text()
+    (tmp_path / "cmp.md").unlink()
+
+    def fail(argv, message):
+        err = run_error(capsys, ["compare", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(stem), "-q",
+                                 *argv])
+        assert re.search(message, err), err
+        assert not (tmp_path / "cmp.md").exists()
+
+    fail(["--samplers", "bose,nosuchsampler", "--reference", str(reference16)], "nosuchsampler")
+    fail(["--samplers", "bose", "--reference", str(tmp_path / "none.exr")], "no such image")
+    small = tmp_path / "small.exr"
+    write_exr(small, np.ones((8, 8, 3), dtype=np.float32))
+    fail(["--samplers", "bose", "--reference", str(small)], r"render with --size 8 8")
+    fail(["--samplers", "bose", "--reference", str(reference16), "--crop", "12", "0", "8", "8"], "does not fit")
+    with pytest.raises(SystemExit) as exc:  # --reference is required
+        main(["compare", "cornell", "-q"])
+    assert exc.value.code == 2
+
+
+def test_compare_unknown_sampler_renders_nothing(tmp_path, capsys, monkeypatch, reference16):
+    calls = []
+    monkeypatch.setattr(commands, "render", lambda *a, **k: calls.append(1))
+    run_error(capsys, ["compare", "cornell", "--samplers", "random,nope", "--reference", str(reference16),
+                       "--out", str(tmp_path / "cmp"), "-q"])
+    assert calls == []
+
+
+# -- pyoa reference ------------------------------------------------------------------------
+
+
+REF_ARGS = ["cornell", "--size", "8", "8", "--spp", "8", "--pass-spp", "4", "-q"]
+
+
+def test_reference_is_the_mean_of_passes(tmp_path):
+    out = tmp_path / "ref.exr"
+    assert main(["reference", *REF_ARGS, "--out", str(out)]) == 0
+    img = read_image(out)
+    assert img.shape == (8, 8, 3)
+    sc = load("cornell")
+    seeds = [commands.pass_seed(0, k) for k in (0, 1)]
+    # independent seeds, none of them a small one a render would use
+    assert len(set(seeds)) == 2 and min(seeds) > 1000
+    passes = [render(sc, sampler="sobol", spp=4, seed=s, width=8, height=8).image.astype(np.float64) for s in seeds]
+    np.testing.assert_array_equal(img, ((passes[0] + passes[1]) / 2).astype(np.float32))
+    assert listing(tmp_path) == ["ref.exr"]  # the state file is removed at the end
+
+
+def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
+    out = tmp_path / "ref.exr"
+    state = tmp_path / "ref.exr.state.npz"
+    # the uninterrupted result
+    assert main(["reference", *REF_ARGS, "--out", str(tmp_path / "full.exr")]) == 0
+    full = read_image(tmp_path / "full.exr")
+
+    real = commands.render
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(kwargs["seed"])
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(commands, "render", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        main(["reference", *REF_ARGS, "--out", str(out)])
+    assert calls == [commands.pass_seed(0, 0), commands.pass_seed(0, 1)]
+    assert state.exists() and not out.exists()
+    with np.load(state) as st:
+        assert int(st["passes"]) == 1 and st["sum"].shape == (8, 8, 3)
+
+    calls.clear()
+
+    def counted(*args, **kwargs):
+        calls.append(kwargs["seed"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(commands, "render", counted)
+    assert main(["reference", *REF_ARGS, "--out", str(out)]) == 0
+    assert calls == [commands.pass_seed(0, 1)]  # only the pass that was missing
+    np.testing.assert_array_equal(read_image(out), full)
+    assert not state.exists()
+
+
+def test_reference_ignores_a_state_of_other_settings(tmp_path, monkeypatch, capsys):
+    out = tmp_path / "ref.exr"
+    real = commands.render
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(kwargs["seed"])
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(commands, "render", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        main(["reference", *REF_ARGS, "--out", str(out)])
+    calls.clear()
+    monkeypatch.setattr(commands, "render", lambda *a, **k: calls.append(k["seed"]) or real(*a, **k))
+    # another seed: the saved pass (of seed 0) is not reused
+    assert main(["reference", *REF_ARGS, "--seed", "10", "--out", str(out)]) == 0
+    assert calls == [commands.pass_seed(10, 0), commands.pass_seed(10, 1)]
+    assert not (tmp_path / "ref.exr.state.npz").exists()
+
+
+def test_reference_errors(tmp_path, capsys):
+    err = run_error(capsys, ["reference", "cornell", "--size", "8", "8", "--spp", "10", "--pass-spp", "4", "-q",
+                             "--out", str(tmp_path / "r.exr")])
+    assert "--spp (10) must be a multiple of --pass-spp (4)" in err
+    err = run_error(capsys, ["reference", "nosuchscene", "--out", str(tmp_path / "r.exr"), "-q"])
+    assert "no such scene" in err
+    assert listing(tmp_path) == []
