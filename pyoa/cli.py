@@ -3,6 +3,7 @@
 ``pyoa points``   generate a point set and save it (.npy or .csv)
 ``pyoa samplers`` list the samplers, ``pyoa spp NAME`` their valid sample counts
 ``pyoa backends`` report the usable backends and OpenCL devices
+``pyoa plot``     every 2D projection of a point set; ``pyoa spectrum`` its power spectrum
 ``pyoa render``   render a scene (EXR/PNG); ``pyoa compare`` tabulate samplers'
                   relative MSE against a reference; ``pyoa reference`` render one
 """
@@ -91,6 +92,44 @@ def cmd_spp(args) -> int:
     return 0
 
 
+def _options(args) -> dict:
+    """The sampler options given on the command line (offset and jitter only when set)."""
+    opts = {"backend": args.backend}
+    if args.offset is not None:
+        opts["offset"] = args.offset
+    if args.jitter is not None:
+        opts["jitter"] = args.jitter
+    if args.strength is not None:
+        opts["strength"] = args.strength
+    return opts
+
+
+def cmd_plot(args) -> int:
+    from .plots import projections
+
+    projections(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, pixel=args.pixel, out=args.out,
+                size=args.size, **_options(args))
+    if not args.quiet:
+        print(f"{args.sampler}, {args.spp} spp, {args.dims} dims -> {args.out}")
+    return 0
+
+
+def cmd_spectrum(args) -> int:
+    from .plots import spectrum
+
+    try:
+        i, j = (int(v) for v in args.dims.split(","))
+    except ValueError:
+        raise ValueError(f"--dims must be two dimensions i,j such as 0,1; got {args.dims!r}") from None
+    _, radii, mean = spectrum(args.sampler, spp=args.spp, dims=(i, j), trials=args.trials, seed=args.seed,
+                              freq=args.freq, out=args.out, size=args.size, **_options(args))
+    if not args.quiet:
+        low = mean[radii <= max(2, len(radii) // 8)].mean()
+        print(f"{args.sampler}, {args.spp} spp, dims {i},{j}, {args.trials} trials: "
+              f"mean low-frequency power {low:.3f} (white noise: 1) -> {args.out}")
+    return 0
+
+
 def cmd_backends(args) -> int:
     for b in backends():
         mark = "*" if b["default"] else " "
@@ -136,6 +175,31 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("backends", help="report the usable backends and OpenCL devices")
     p.set_defaults(func=cmd_backends)
+
+    def figure_options(p, out):
+        p.add_argument("sampler", help="sampler name (see `pyoa samplers`)")
+        p.add_argument("--spp", type=int, default=121, help="samples per pixel (default 121)")
+        p.add_argument("--seed", type=int, default=0, help="user seed (default 0)")
+        p.add_argument("--offset", choices=OFFSETS, default=None, help="offset style of OA samplers")
+        p.add_argument("--jitter", type=float, default=None, help="jitter amount in [0, 1]")
+        p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
+        p.add_argument("--backend", choices=("opencl", "numpy"), default=None)
+        p.add_argument("--size", type=int, default=900, help="figure size in pixels (default 900)")
+        p.add_argument("--out", default=out, help=f"PNG output (default {out})")
+        p.add_argument("-q", "--quiet", action="store_true")
+
+    p = sub.add_parser("plot", help="plot every 2D projection of one pixel's point set (PNG)")
+    figure_options(p, "projections.png")
+    p.add_argument("--dims", type=int, default=6, help="dimensions, 2..16 (default 6)")
+    p.add_argument("--pixel", type=int, default=0, help="pixel index (default 0)")
+    p.set_defaults(func=cmd_plot)
+
+    p = sub.add_parser("spectrum", help="expected power spectrum of a 2D projection (PNG)")
+    figure_options(p, "spectrum.png")
+    p.add_argument("--dims", default="0,1", help="the two dimensions i,j (default 0,1)")
+    p.add_argument("--trials", type=int, default=64, help="randomizations averaged (default 64)")
+    p.add_argument("--freq", type=int, default=48, help="largest integer frequency shown (default 48)")
+    p.set_defaults(func=cmd_spectrum)
 
     from .render.commands import add_parsers
 
