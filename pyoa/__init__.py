@@ -23,3 +23,13 @@ __all__ = [
     "sampler", "samplers", "Sampler", "valid_spp", "SppChoice", "backends", "reference",
     "OFFSETS", "PyoaFallbackWarning", "__version__",
 ]
+
+
+def __getattr__(name):
+    # Submodules with heavier imports (scipy, matplotlib, embreex) load on
+    # first use: `pyoa.qmc.OrthogonalArray` works without importing them up front.
+    if name in ("qmc", "analysis", "plots", "render"):
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
