@@ -38,6 +38,13 @@ __kernel void NAME(__global float *out, __global const uint *tab, const uint n_v
     BODY
 }
 '''
+head_fast = head.replace("""    uint row = gid / 10u;
+    uint d = gid % 10u;
+    uint i = row % 121u;
+    uint base = ((row / 121u) * 10u + d) * 23u;""", """    uint i = gid % 121u;
+    uint t = gid / 121u;
+    uint d = t % 10u;
+    uint base = t * 23u;""")
 bodies = {
   "nogather_nodiv": "out[gid] = (float)(aij * 11u + aik) * 0x1.0p-8f;",
   "gather_nodiv": "out[gid] = (float)(tab[base + aij] * 11u + tab[base + 11u + aik]) * 0x1.0p-8f + (float)tab[base + 22u];",
@@ -46,7 +53,13 @@ bodies = {
   "nogather_samplevalue": "out[gid] = sample_value(aij, (float)aik, jitter_value(randfloat(i, base * 0x9e3779b9u), 1.0f), 11u, 11u);",
   "full": "out[gid] = sample_value(tab[base + aij], (float)tab[base + 11u + aik], jitter_value(randfloat(i, tab[base + 22u]), 1.0f), 11u, 11u);",
 }
+FULL = "out[gid] = sample_value(tab[base + aij], (float)tab[base + 11u + aik], jitter_value(randfloat(i, tab[base + 22u]), 1.0f), 11u, 11u);"
+FULL_SCATTER = FULL.replace("out[gid]", "out[((t / 10u) * 121u + i) * 10u + d]")
 src = base_src + "".join(head.replace("NAME", k).replace("BODY", v) for k, v in bodies.items())
+src += head_fast.replace("NAME", "samplefast_full").replace("BODY", FULL)
+src += head_fast.replace("NAME", "samplefast_full_scatter").replace("BODY", FULL_SCATTER)
+bodies["samplefast_full"] = None
+bodies["samplefast_full_scatter"] = None
 plat = [p for p in cl.get_platforms() if "Portable" in p.name][0]
 dev = plat.get_devices()[0]
 ctx = cl.Context([dev]); q = cl.CommandQueue(ctx)
