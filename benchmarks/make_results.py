@@ -24,7 +24,6 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
-import numpy as np  # noqa: E402
 
 from pyoa import analysis, cli  # noqa: E402
 from pyoa.atomic import atomic_path  # noqa: E402

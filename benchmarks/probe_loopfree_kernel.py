@@ -11,27 +11,12 @@ sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parent.par
 from pyoa._opencl import program as prog
 import pyoa
 src = prog.source() + r'''
-inline uint kround(uint i, uint p, uint w) {
-    i ^= p;             i *= 0xe170893du;
-    i ^= p >> 16;
-    i ^= (i & w) >> 4;
-    i ^= p >> 8;        i *= 0x0929eb3fu;
-    i ^= p >> 23;
-    i ^= (i & w) >> 1;  i *= 1u | (p >> 27);
-    i *= 0x6935fa69u;
-    i ^= (i & w) >> 11; i *= 0x74dcb303u;
-    i ^= (i & w) >> 2;  i *= 0x9e501cc3u;
-    i ^= (i & w) >> 2;  i *= 0xc860a3dfu;
-    i &= w;
-    i ^= i >> 5;
-    return i;
-}
 /* permute with the cycle walk unrolled to its bound: ROUNDS = w + 2 - l */
 inline uint permute_u(uint i, uint l, uint w, uint p) {
     uint x = i, res = 0u, done = 0u;
     #pragma unroll
     for (uint r = 0u; r < ROUNDS; ++r) {
-        x = kround(x, p, w);
+        x = permute_round(x, p, w);  /* kernels/hashes.cl */
         uint take = (done == 0u) & (x < l);
         res = take ? x : res;
         done |= take;

@@ -11,6 +11,24 @@
 #define PIXEL_KEY      0x5bd1e995u
 #define BLOCK_KEY      0x1b873593u
 
+/* One pass of Kensler's bijection on [0, w] (the body of the cycle walk). */
+uint permute_round(uint i, uint p, uint w)
+{
+    i ^= p;             i *= 0xe170893du;
+    i ^= p >> 16;
+    i ^= (i & w) >> 4;
+    i ^= p >> 8;        i *= 0x0929eb3fu;
+    i ^= p >> 23;
+    i ^= (i & w) >> 1;  i *= 1u | (p >> 27);
+    i *= 0x6935fa69u;
+    i ^= (i & w) >> 11; i *= 0x74dcb303u;
+    i ^= (i & w) >> 2;  i *= 0x9e501cc3u;
+    i ^= (i & w) >> 2;  i *= 0xc860a3dfu;
+    i &= w;
+    i ^= i >> 5;
+    return i;
+}
+
 /* Kensler's permute with the wrap-safe final shift; 1 <= l <= 2^31. */
 uint permute(uint i, uint l, uint p)
 {
@@ -18,18 +36,7 @@ uint permute(uint i, uint l, uint p)
     uint w = l - 1u;
     w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
     do {
-        i ^= p;             i *= 0xe170893du;
-        i ^= p >> 16;
-        i ^= (i & w) >> 4;
-        i ^= p >> 8;        i *= 0x0929eb3fu;
-        i ^= p >> 23;
-        i ^= (i & w) >> 1;  i *= 1u | (p >> 27);
-        i *= 0x6935fa69u;
-        i ^= (i & w) >> 11; i *= 0x74dcb303u;
-        i ^= (i & w) >> 2;  i *= 0x9e501cc3u;
-        i ^= (i & w) >> 2;  i *= 0xc860a3dfu;
-        i &= w;
-        i ^= i >> 5;
+        i = permute_round(i, p, w);
     } while (i >= l);
     return (i + p % l) % l;
 }

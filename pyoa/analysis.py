@@ -58,6 +58,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .constructions import nearest_spp
+from .samplers import _int as _checked_int
+
 __all__ = [
     "StratificationReport", "stratification", "latin_hypercube", "cells", "discrepancy",
     "Integrand", "INTEGRANDS", "integrand", "gaussian", "anisotropic_gaussian", "oscillatory",
@@ -72,13 +75,11 @@ MAX_SUBSETS = 1_000_000
 # ============================================================================ helpers
 
 def _int(name: str, value, lo: int | None = None, hi: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
-    value = int(value)
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        rng = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
-        raise ValueError(f"{name} must be {rng}, got {value}")
-    return value
+    """:func:`pyoa.samplers._int`, but every bad value is a ValueError here."""
+    try:
+        return _checked_int(name, value, lo, hi)
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None
 
 
 def _points(points, what: str = "points", closed: bool = False) -> np.ndarray:
@@ -1024,9 +1025,8 @@ def convergence(samplers, integrand, d: int, spp_targets, *, trials: int = 64, s
         res.strength[name] = t
         counts, far = set(), set()
         for n in targets:
-            choices = pyoa.valid_spp(name, near=n, dims=d, strength=t)
-            if choices:
-                best = min(choices, key=lambda c: (abs(c.spp - n), c.spp)).spp
+            best = nearest_spp(name, n, dims=d, strength=t)
+            if best is not None:
                 (counts if n / max_ratio <= best <= n * max_ratio else far).add(best)
         if not counts:
             at = f" at strength {t}" if t else ""

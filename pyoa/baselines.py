@@ -14,7 +14,6 @@ References
 
 from __future__ import annotations
 
-import importlib
 import math
 from collections.abc import Sequence
 
@@ -110,10 +109,9 @@ class Baseline(Construction):
             return f"{spp} is not a power of two in [1, 2^24]"
         return f"{spp} is not in [1, 2^24]"
 
-    def call(self, package: str, i, j, params: Params, p, offset, jitter):
-        f = getattr(importlib.import_module(f"{package}.{self.module}"), self.function)
-        extra = (jitter,) if self.jittered else ()
-        return f(i, j, *self.shape_args(params), p, *extra)
+    def options(self, offset, jitter):
+        # no offset styles; a jitter amount only where the sampler has one
+        return (jitter,) if self.jittered else ()
 
     def shape_args(self, params):
         return ()

@@ -183,11 +183,15 @@ class Construction:
     def shape_args(self, params: Params) -> tuple[int, ...]:
         return (params.s, params.strength)
 
+    def options(self, offset, jitter) -> tuple:
+        """The arguments after ``p`` of ``function``: offset and jitter for the OAs."""
+        return (offset, jitter)
+
     def call(self, package: str, i, j, params: Params, p, offset, jitter):
         """Evaluate with the implementation in ``package`` (``"pyoa.reference"``
-        or ``"pyoa._numpy"``): ``function(i, j, *shape_args(params), p, offset, jitter)``."""
+        or ``"pyoa._numpy"``): ``function(i, j, *shape_args(params), p, *options(offset, jitter))``."""
         f = getattr(importlib.import_module(f"{package}.{self.module}"), self.function)
-        return f(i, j, *self.shape_args(params), p, offset, jitter)
+        return f(i, j, *self.shape_args(params), p, *self.options(offset, jitter))
 
     def choices(self, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
         raise NotImplementedError
@@ -489,3 +493,13 @@ def valid_spp(name: str, near: int | None = None, dims: int | None = None, stren
     if near is None:
         return construction.choices(dims=dims, strength=strength)
     return construction.nearest(int(near), dims=dims, strength=strength)
+
+
+def nearest_spp(name: str, spp: int, dims: int | None = None, strength: int | None = None) -> int | None:
+    """The valid sample count of ``name`` closest to ``spp`` (``spp`` itself if
+    valid; ties go to fewer samples), or None if there is none for these
+    ``dims`` and ``strength``. Used wherever a requested count is replaced by
+    a sampler's nearest one (``pyoa compare``, convergence studies, the qmc
+    engine's default)."""
+    choices = valid_spp(name, near=spp, dims=dims, strength=strength)
+    return min((c.spp for c in choices), key=lambda n: (abs(n - spp), n)) if choices else None

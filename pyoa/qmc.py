@@ -240,10 +240,9 @@ class OrthogonalArray(qmc.QMCEngine):
             super().__init__(d=d, optimization=optimization, seed=rng)
 
         if spp is None:
-            choices = constructions.valid_spp(name, near=DEFAULT_SPP_TARGET, dims=d, strength=strength)
-            if not choices:
+            spp = constructions.nearest_spp(name, DEFAULT_SPP_TARGET, dims=d, strength=strength)
+            if spp is None:
                 raise ValueError(f"{name} has no valid sample count for d={d}, strength={strength}")
-            spp = min(choices, key=lambda c: (abs(c.spp - DEFAULT_SPP_TARGET), c.spp)).spp
         self.pyoa_seed = _draw_seed(self.rng)
         # pyoa validates spp (naming the nearest valid counts), strength,
         # offset, jitter and backend.

@@ -648,3 +648,51 @@ def randfloat_preimage(h: int, p: int) -> int:
     x = _unxorshift(x, 10)
     x = _unxorshift(x, 17)
     return x ^ p
+
+
+def run_cli(args, capsys):
+    """Run ``pyoa ARGS`` in-process: (exit status, stdout, stderr)."""
+    from pyoa import cli
+
+    try:
+        code = cli.main([str(a) for a in args])
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def kernel_runner(backend, test_kernels: str):
+    """Build ``test_kernels`` after pyoa's own program source (same build
+    options) on ``backend``'s OpenCL device, and return
+    ``run(name, outs, *args, n=None)``: it uploads the ndarray arguments,
+    passes the others as they are, appends one output buffer per dtype in
+    ``outs``, launches ``n`` work-items (default: the common size of the
+    array arguments) and returns the outputs (one array, or a list)."""
+    import pyopencl as cl
+
+    from pyoa._opencl import program as prog
+
+    ctx, queue = backend.context, backend.queue
+    program = cl.Program(ctx, prog.source() + "\n" + test_kernels).build(options=prog.BUILD_OPTIONS + prog.defines())
+    kernels = {}
+
+    def run(name, outs, *args, n=None):
+        mf = cl.mem_flags
+        arrays = [a for a in args if isinstance(a, np.ndarray)]
+        if n is None:
+            n = arrays[0].size
+            assert all(a.size == n for a in arrays), "array arguments of different sizes need n="
+        kargs = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a).ravel())
+                 if isinstance(a, np.ndarray) else a for a in args]
+        results = [np.empty(n, dtype=dt) for dt in outs]
+        bufs = [cl.Buffer(ctx, mf.WRITE_ONLY, size=max(4, r.nbytes)) for r in results]
+        if name not in kernels:
+            kernels[name] = cl.Kernel(program, name)
+        kernels[name](queue, (n,), None, *kargs, *bufs)
+        for r, b in zip(results, bufs):
+            cl.enqueue_copy(queue, r, b)
+        queue.finish()
+        return results if len(results) > 1 else results[0]
+
+    return run

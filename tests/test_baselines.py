@@ -48,11 +48,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import pyoa
-from pyoa import cli
 from pyoa import sequences
 from pyoa._numpy import baselines as nb
 from pyoa.reference import baselines as rb
-from tests.helpers import U32_MAX, assert_same_bits
+from tests.helpers import U32_MAX, assert_same_bits, run_cli
 
 F32 = np.float32
 UNIT24 = 2.0**-24
@@ -906,14 +905,6 @@ def test_value_equals_generate_and_repr(backend, name, spp, grid_text):
 
 
 # =============================================================================== command line
-
-def run_cli(args, capsys):
-    try:
-        code = cli.main([str(a) for a in args])
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.mark.parametrize("name, spp, extra", [("random", 10, []), ("jittered2d", 16, ["--jitter", "0.5"]),

@@ -28,7 +28,7 @@ from pyoa import reference as ref
 from pyoa import sequences
 from pyoa._numpy import baselines as nbl
 from pyoa.reference import baselines as rbl
-from tests.helpers import PIXEL_KEY, U32_MAX, assert_same_bits
+from tests.helpers import PIXEL_KEY, U32_MAX, assert_same_bits, kernel_runner
 
 U32 = np.uint32
 F32 = np.float32
@@ -610,29 +610,7 @@ __kernel void tb_sample(__global const uint *i, __global const uint *j, __global
 @pytest.fixture(scope="module")
 def harness(opencl):
     """Run a test kernel of TEST_KERNELS, built with pyoa's own source and options."""
-    import pyopencl as cl
-
-    from pyoa._opencl import program as prog
-
-    ctx, queue = opencl.context, opencl.queue
-    program = cl.Program(ctx, prog.source() + "\n" + TEST_KERNELS).build(options=prog.BUILD_OPTIONS + prog.defines())
-    kernels = {}
-
-    def run(name, n, outs, *args):
-        mf = cl.mem_flags
-        kargs = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a).ravel())
-                 if isinstance(a, np.ndarray) else a for a in args]
-        results = [np.empty(n, dtype=dt) for dt in outs]
-        bufs = [cl.Buffer(ctx, mf.WRITE_ONLY, size=max(4, r.nbytes)) for r in results]
-        if name not in kernels:
-            kernels[name] = cl.Kernel(program, name)
-        kernels[name](queue, (n,), None, *kargs, *bufs)
-        for r, b in zip(results, bufs):
-            cl.enqueue_copy(queue, r, b)
-        queue.finish()
-        return results if len(results) > 1 else results[0]
-
-    return run
+    return kernel_runner(opencl, TEST_KERNELS)
 
 
 @pytest.mark.opencl
@@ -640,7 +618,7 @@ def test_kernel_helpers_equal_numpy(harness):
     x = _u32_inputs(20000, RNG_SEED + 3)
     seeds = np.roll(x, 11)
     seeds[::5] = 0
-    rev, lk, owen, u24 = harness("tb_helpers", len(x), [U32, U32, U32, F32], x, seeds)
+    rev, lk, owen, u24 = harness("tb_helpers", [U32, U32, U32, F32], x, seeds, n=len(x))
     assert np.array_equal(rev, nbl.reverse_bits(x))
     assert np.array_equal(lk, nbl.laine_karras(x, seeds))
     assert np.array_equal(owen, nbl.owen_scramble(x, seeds))
@@ -649,7 +627,7 @@ def test_kernel_helpers_equal_numpy(harness):
     rng = np.random.default_rng(RNG_SEED + 4)
     dim = rng.integers(0, SOBOL_DIMS, len(x)).astype(U32)
     dim[:3] = [0, 1, SOBOL_DIMS - 1]
-    got = harness("tb_sobol_bits", len(x), [U32], x, dim, np.ascontiguousarray(sequences.sobol_matrices()))
+    got = harness("tb_sobol_bits", [U32], x, dim, np.ascontiguousarray(sequences.sobol_matrices()), n=len(x))
     assert np.array_equal(got, nbl.sobol_bits(x, dim))
 
 
@@ -668,6 +646,6 @@ def test_kernel_functions_equal_numpy(harness, name, shape, p_mode):
              "sobol02": sequences.sobol_matrices()[:2]}.get(name, np.zeros(1, U32))
     a, b = (*shape, 0, 0)[:2]
     for jitter in ([1.0, MANY_BITS[0], 0.0] if name in JITTERED else [1.0]):
-        got = harness("tb_sample", len(i), [F32], i, j, p, U32(KERNEL_CODE[name]), U32(a), U32(b), F32(jitter),
-                      np.ascontiguousarray(table, dtype=U32))
+        got = harness("tb_sample", [F32], i, j, p, U32(KERNEL_CODE[name]), U32(a), U32(b), F32(jitter),
+                      np.ascontiguousarray(table, dtype=U32), n=len(i))
         assert_same_bits(got, np_values(name, i, j, shape, p, jitter), f"kernel vs numpy, J={jitter}")

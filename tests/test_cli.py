@@ -13,17 +13,7 @@ import pytest
 
 import pyoa
 from pyoa import cli
-from tests.helpers import assert_same_bits
-
-
-def run_cli(args, capsys):
-    """Run ``pyoa ARGS`` in-process: (exit status, stdout, stderr)."""
-    try:
-        code = cli.main([str(a) for a in args])
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
+from tests.helpers import assert_same_bits, run_cli
 
 
 def leftovers(folder, name):

@@ -359,7 +359,7 @@ def _find_clamped_sample(max_tries: int = 40):
     """A (pixel, sample) of cmjnd s=2, t=24, dimension 0, whose value rounds to 1.0
     and must be clamped: stratum 1, sub-stratum M-1 = 2^23-1 and a jitter above 0.75
     (sub + jitter then rounds to 2^23 in float32). Found by inverting the permutations."""
-    s, t, M = 2, 24, 2**23
+    s, M = 2, 2**23  # t = 24
     for pixel in range(max_tries):
         p = ref.pixel_seed(0, pixel)
         P1, P2, P3 = ref.dimension_seeds(p, 0)

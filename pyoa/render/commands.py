@@ -12,16 +12,16 @@ import numpy as np
 
 from .. import constructions
 from ..atomic import atomic_path
+from ..cli import _rate
 from .image import read_image, rel_mse, write_exr, write_png
 from .render import render
 from .scene import load
 
 
-def _rate(x: float) -> str:
-    for unit, scale in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
-        if x >= scale:
-            return f"{x / scale:.3g} {unit}"
-    return f"{x:.3g} "
+def _size(args) -> dict:
+    """``width``/``height`` keyword arguments of ``render`` from ``--size W H`` (None: the scene's)."""
+    w, h = args.size or (None, None)
+    return dict(width=w, height=h)
 
 
 def _reference(path, shape):
@@ -35,7 +35,7 @@ def _reference(path, shape):
 def cmd_render(args) -> int:
     scene = load(args.scene)
     res = render(scene, sampler=args.sampler, spp=args.spp, seed=args.seed,
-                 width=args.size[0] if args.size else None, height=args.size[1] if args.size else None,
+                 **_size(args),
                  max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
                  progress=not args.quiet)
     write_exr(args.out, res.image)
@@ -55,12 +55,6 @@ def cmd_render(args) -> int:
     return 0
 
 
-def nearest_spp(name: str, spp: int) -> int:
-    """``spp`` if the sampler accepts it, else its nearest valid count (ties: fewer)."""
-    best = constructions.get(name).nearest(spp)
-    return min((c.spp for c in best), key=lambda n: (abs(n - spp), n))
-
-
 def cmd_compare(args) -> int:
     scene = load(args.scene)
     names = [n.strip() for n in args.samplers.split(",") if n.strip()]
@@ -70,9 +64,9 @@ def cmd_compare(args) -> int:
     rows = []
     crops = []
     for name in names:
-        spp = nearest_spp(name, args.spp)
+        spp = constructions.nearest_spp(name, args.spp)
         res = render(scene, sampler=name, spp=spp, seed=args.seed,
-                     width=args.size[0] if args.size else None, height=args.size[1] if args.size else None,
+                     **_size(args),
                      max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
                      progress=not args.quiet)
         if ref is None:
@@ -174,7 +168,7 @@ def cmd_reference(args) -> int:
 
     for k in tqdm(range(done, passes), initial=done, total=passes, desc="reference passes", disable=args.quiet):
         res = render(scene, sampler=args.sampler, spp=args.pass_spp, seed=pass_seed(args.seed, k),
-                     width=args.size[0] if args.size else None, height=args.size[1] if args.size else None,
+                     **_size(args),
                      max_depth=args.max_depth, filter=args.filter, backend=args.backend)
         img = res.image.astype(np.float64)
         total = img if total is None else total + img

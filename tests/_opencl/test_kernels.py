@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pyoa._opencl import program as prog
-from tests.helpers import U32_MAX, assert_same_bits, permute_cases, randfloat_cases, seed_pair_cases
+from tests.helpers import U32_MAX, assert_same_bits, kernel_runner, permute_cases, randfloat_cases, seed_pair_cases
 
 pytestmark = pytest.mark.opencl
 U32 = np.uint32
@@ -78,35 +78,7 @@ __kernel void t_bb_cell(__global const uint *i, __global const uint *j, const ui
 
 @pytest.fixture(scope="module")
 def harness(opencl):
-    import pyopencl as cl
-
-    ctx, queue = opencl.context, opencl.queue
-    program = cl.Program(ctx, prog.source() + "\n" + TEST_KERNELS).build(options=prog.BUILD_OPTIONS + prog.defines())
-
-    kernels = {}
-
-    def run(name, outs, *args):
-        mf = cl.mem_flags
-        n = None
-        kargs = []
-        for a in args:
-            if isinstance(a, np.ndarray):
-                n = a.size if n is None else n
-                assert a.size == n
-                kargs.append(cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a)))
-            else:
-                kargs.append(a)
-        results = [np.empty(n, dtype=dt) for dt in outs]
-        bufs = [cl.Buffer(ctx, mf.WRITE_ONLY, size=max(4, r.nbytes)) for r in results]
-        if name not in kernels:
-            kernels[name] = cl.Kernel(program, name)
-        kernels[name](queue, (n,), None, *kargs, *bufs)
-        for r, b in zip(results, bufs):
-            cl.enqueue_copy(queue, r, b)
-        queue.finish()
-        return results if len(results) > 1 else results[0]
-
-    return run
+    return kernel_runner(opencl, TEST_KERNELS)
 
 
 def test_permute_matches_c_oracle(harness, spec_c):

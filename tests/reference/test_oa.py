@@ -22,7 +22,6 @@ from pyoa.reference.floats import jitter_value, sample_value
 from tests.helpers import (
     AK_Q,
     BB_S,
-    OFFSET_CODE,
     U32_MAX,
     ak_constants_independent,
     index2_symbol,

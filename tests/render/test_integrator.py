@@ -408,7 +408,7 @@ def test_mirror_reflects_the_emitter(tmp_path, mis, depth):
 def test_emitters_are_one_sided(tmp_path):
     """Emitters are one-sided: a camera below the light looking up sees Le,
     one above it looking down at its (black) back sees nothing."""
-    sc = light_scene(tmp_path, floor={"type": "diffuse"}, max_depth=4)
+    light_scene(tmp_path, floor={"type": "diffuse"}, max_depth=4)
     data = json.loads((tmp_path / "light.json").read_text())
     data["camera"]["to_world"] = affine(np.eye(3), (0, 0, 0.5))  # below the light, looking up (+z)
     res = render(write_scene(tmp_path, data, "front"), sampler="random", spp=4, max_depth=1)

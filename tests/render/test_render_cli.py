@@ -273,6 +273,26 @@ def test_reference_is_the_mean_of_passes(tmp_path):
     assert listing(tmp_path) == ["ref.exr"]  # the state file is removed at the end
 
 
+#: commands.render itself, before any test wraps it
+REAL_RENDER = commands.render
+
+
+def record_passes(monkeypatch, fail_at=None):
+    """Wrap commands.render (one call per reference pass): record each pass's
+    seed, and raise KeyboardInterrupt in call ``fail_at`` (1-based) to
+    simulate an interrupted run. Returns the list of seeds."""
+    calls = []
+
+    def wrapped(*args, **kwargs):
+        calls.append(kwargs["seed"])
+        if len(calls) == fail_at:
+            raise KeyboardInterrupt
+        return REAL_RENDER(*args, **kwargs)
+
+    monkeypatch.setattr(commands, "render", wrapped)
+    return calls
+
+
 def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
     out = tmp_path / "ref.exr"
     state = tmp_path / "ref.exr.state.npz"
@@ -280,16 +300,7 @@ def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
     assert main(["reference", *REF_ARGS, "--out", str(tmp_path / "full.exr")]) == 0
     full = read_image(tmp_path / "full.exr")
 
-    real = commands.render
-    calls = []
-
-    def interrupted(*args, **kwargs):
-        calls.append(kwargs["seed"])
-        if len(calls) == 2:
-            raise KeyboardInterrupt
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(commands, "render", interrupted)
+    calls = record_passes(monkeypatch, fail_at=2)
     with pytest.raises(KeyboardInterrupt):
         main(["reference", *REF_ARGS, "--out", str(out)])
     assert calls == [commands.pass_seed(0, 0), commands.pass_seed(0, 1)]
@@ -297,13 +308,7 @@ def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
     with np.load(state) as st:
         assert int(st["passes"]) == 1 and st["sum"].shape == (8, 8, 3)
 
-    calls.clear()
-
-    def counted(*args, **kwargs):
-        calls.append(kwargs["seed"])
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(commands, "render", counted)
+    calls = record_passes(monkeypatch)
     assert main(["reference", *REF_ARGS, "--out", str(out)]) == 0
     assert calls == [commands.pass_seed(0, 1)]  # only the pass that was missing
     np.testing.assert_array_equal(read_image(out), full)
@@ -312,20 +317,10 @@ def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
 
 def test_reference_ignores_a_state_of_other_settings(tmp_path, monkeypatch, capsys):
     out = tmp_path / "ref.exr"
-    real = commands.render
-    calls = []
-
-    def interrupted(*args, **kwargs):
-        calls.append(kwargs["seed"])
-        if len(calls) == 2:
-            raise KeyboardInterrupt
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(commands, "render", interrupted)
+    record_passes(monkeypatch, fail_at=2)
     with pytest.raises(KeyboardInterrupt):
         main(["reference", *REF_ARGS, "--out", str(out)])
-    calls.clear()
-    monkeypatch.setattr(commands, "render", lambda *a, **k: calls.append(k["seed"]) or real(*a, **k))
+    calls = record_passes(monkeypatch)
     # another seed: the saved pass (of seed 0) is not reused
     assert main(["reference", *REF_ARGS, "--seed", "10", "--out", str(out)]) == 0
     assert calls == [commands.pass_seed(10, 0), commands.pass_seed(10, 1)]
