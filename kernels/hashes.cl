@@ -29,16 +29,28 @@ uint permute_round(uint i, uint p, uint w)
     return i;
 }
 
+/* w = the all-ones mask just covering l - 1 (the walk's domain [0, w]). */
+uint walk_mask(uint l)
+{
+    uint w = l - 1u;
+    w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
+    return w;
+}
+
+/* The cycle walk: the first of round(i), round(round(i)), ... below l. */
+uint permute_walk(uint i, uint l, uint p, uint w)
+{
+    do {
+        i = permute_round(i, p, w);
+    } while (i >= l);
+    return i;
+}
+
 /* Kensler's permute with the wrap-safe final shift; 1 <= l <= 2^31. */
 uint permute(uint i, uint l, uint p)
 {
     if (p == 0u) return i;
-    uint w = l - 1u;
-    w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
-    do {
-        i = permute_round(i, p, w);
-    } while (i >= l);
-    return (i + p % l) % l;
+    return (permute_walk(i, l, p, walk_mask(l)) + p % l) % l;
 }
 
 /* Kensler's randfloat: float in [0, 1); 0.5 for p == 0. Written without an

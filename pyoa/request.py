@@ -43,17 +43,59 @@ class Request:
         jitter seed (the layout of ``kernels/generate.cl``)."""
         return self.params.s + (self.params.M if self.offset == "cmj" else 0) + 1
 
-    def tables_pay_off(self, row0: int, row1: int) -> bool:
-        """Whether rows ``[row0, row1)`` should use the table path.
+    def rectangles(self, row0: int, row1: int) -> list["Rect"]:
+        """Rows ``[row0, row1)`` as rectangles of pixels x sample positions.
+
+        A rectangle is either whole pixels (all sample positions) or a run of
+        sample positions inside one pixel, so a chunk boundary that falls inside
+        a pixel gives at most a head and a tail rectangle around the whole
+        pixels. The table path works per rectangle: its kernels index by
+        (sample position, pixel and dimension) instead of dividing a flat row
+        index (docs/performance.md).
+        """
+        n_s = len(self.samples)
+        rects = []
+        r = row0
+        while r < row1:
+            pix, k = divmod(r, n_s)
+            if k or row1 - r < n_s:  # part of one pixel
+                r1 = min(row1, (pix + 1) * n_s)
+                rects.append(Rect(r, r1, pix, pix + 1, k, k + r1 - r))
+            else:
+                r1 = r + (row1 - r) // n_s * n_s
+                rects.append(Rect(r, r1, pix, r1 // n_s, 0, n_s))
+            r = r1
+        return rects
+
+    def tables_pay_off(self, rect: "Rect") -> bool:
+        """Whether rectangle ``rect`` should use the table path.
 
         The table path (``cmj`` and ``centered`` only) first computes
-        :attr:`table_entries` values per (pixel, dimension) for every pixel the
-        rows touch, then gathers. It pays off when that table is no larger than the
-        chunk's output; the same bound keeps the table buffer within the
-        chunk size limits the backends already respect.
+        :attr:`table_entries` values per (pixel, dimension), then gathers one
+        per value. It pays off when a table is no longer than the rectangle's
+        run of samples, i.e. the tables are no larger than the output; the
+        same bound keeps the table buffer within the chunk size limits the
+        backends already respect.
         """
-        if self.offset not in ("cmj", "centered") or row1 <= row0:
-            return False
-        n_s = len(self.samples)
-        n_pixels = (row1 - 1) // n_s - row0 // n_s + 1
-        return n_pixels * self.table_entries <= row1 - row0
+        return self.offset in ("cmj", "centered") and self.table_entries <= rect.n_k
+
+
+@dataclass(frozen=True)
+class Rect:
+    """Rows ``[row0, row1)`` of a request: pixels ``[pix0, pix1)`` x sample
+    positions ``[k0, k1)`` (see :meth:`Request.rectangles`)."""
+
+    row0: int
+    row1: int
+    pix0: int
+    pix1: int
+    k0: int
+    k1: int
+
+    @property
+    def n_k(self) -> int:
+        return self.k1 - self.k0
+
+    @property
+    def n_pixels(self) -> int:
+        return self.pix1 - self.pix0

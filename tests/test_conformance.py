@@ -321,9 +321,9 @@ def _tabled_equals_direct(smp, monkeypatch, pixels, samples=None, dims=None):
     from pyoa.request import Request
 
     req = smp._request(pixels, samples, dims)
-    assert req.tables_pay_off(0, req.n_rows)
+    assert all(req.tables_pay_off(rect) for rect in req.rectangles(0, req.n_rows))
     tabled = smp.generate(pixels=pixels, samples=samples, dims=dims)
-    monkeypatch.setattr(Request, "tables_pay_off", lambda self, a, b: False)
+    monkeypatch.setattr(Request, "tables_pay_off", lambda self, rect: False)
     assert_same_bits(tabled, smp.generate(pixels=pixels, samples=samples, dims=dims), "table path vs direct path")
     return tabled
 
@@ -448,8 +448,8 @@ def test_index2_table_path_at_the_largest_sizes(backend, name, s, offset, monkey
                                      ("bose-bush", 4), ("bose-bush", 16)])
 @pytest.mark.parametrize("offset", ["cmj", "centered"])
 def test_index2_table_and_direct_paths_agree(backend, name, s, offset, monkeypatch):
-    """All samples of a few pixels (the table path: kernels generate_tabled_addelman_kempthorne
-    and generate_tabled_bose_bush, NumPy's gather) and the same values with tables
+    """All samples of a few pixels (the table path: kernels tables and
+    generate_cells, NumPy's gather) and the same values with tables
     switched off (the direct path) are the same bits, and match the reference."""
     N, d = 2 * s * s, 2 * s + 1
     smp = pyoa.sampler(name, spp=N, dims=d + 2, seed=99, offset=offset, backend=backend)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
-from ..request import Request
+from ..request import Rect, Request
 from . import oa
 from .floats import F32
 from .hashes import U32, permute, pixel_seed
@@ -35,37 +35,38 @@ class NumpyBackend:
 
     def fill(self, req: Request, row0: int, row1: int, out: np.ndarray) -> None:
         """Write rows ``[row0, row1)`` of ``req`` into ``out`` (shape ``(row1-row0, n_dims)``)."""
-        rows = np.arange(row0, row1, dtype=np.int64)
-        n_s = len(req.samples)
-        prm = req.params
-        i = req.samples[rows % n_s][:, None]
-        if req.tables_pay_off(row0, row1):
-            out[...] = self._tabled(req, rows, i)
-            return
-        p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
-        out[...] = req.construction.call("pyoa._numpy", i, req.dims[None, :], prm, p, req.offset, req.jitter)
+        for rect in req.rectangles(row0, row1):
+            view = out[rect.row0 - row0 : rect.row1 - row0]
+            if req.tables_pay_off(rect):
+                view[...] = self._tabled(req, rect).reshape(view.shape)
+            else:
+                self._direct(req, rect, view)
 
     @staticmethod
-    def _tabled(req: Request, rows: np.ndarray, i: np.ndarray) -> np.ndarray:
-        prm = req.params
-        s, M, dmax = prm.s, prm.M, prm.block_dims
+    def _direct(req: Request, rect: Rect, out: np.ndarray) -> None:
+        rows = np.arange(rect.row0, rect.row1, dtype=np.int64)
         n_s = len(req.samples)
-        pix0 = rows[0] // n_s
-        local = (rows // n_s - pix0)[:, None]  # pixel of each row, within this chunk
-        q = oa.column_key(pixel_seed(req.seed, req.pixels[pix0 : rows[-1] // n_s + 1])[:, None], req.dims[None, :], dmax)
-        strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])
-        col = (req.dims % U32(dmax))[None, :]
-        d = np.arange(req.n_dims)[None, :]
-        aij, u = {
-            "bose": lambda: oa.bose_cell(i, col, s),
-            "bush": lambda: oa.bush_cell(i, col, s, prm.strength),
-            "cmjnd": lambda: oa.cmjnd_cell(i, col, s),
-            "addelman-kempthorne": lambda: oa.addelman_kempthorne_cell(i, col, s),
-            "bose-bush": lambda: oa.bose_bush_cell(i, col, s),
-        }[req.construction.name]()
+        i = req.samples[rows % n_s][:, None]
+        p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
+        out[...] = req.construction.call("pyoa._numpy", i, req.dims[None, :], req.params, p, req.offset, req.jitter)
+
+    @staticmethod
+    def _tabled(req: Request, rect: Rect) -> np.ndarray:
+        """Values of ``rect`` as ``(pixels, samples, dims)``: the per-(pixel,
+        dimension) permutations computed once, the pixel-independent cells
+        (:func:`.oa.cells`) once, then one gather per value."""
+        prm = req.params
+        s, M = prm.s, prm.M
+        q = oa.column_key(pixel_seed(req.seed, req.pixels[rect.pix0 : rect.pix1])[:, None], req.dims[None, :],
+                          prm.block_dims)  # (pixels, dims)
+        aij, u = (c.T for c in oa.cells(req, rect.k0, rect.k1))  # (samples, dims)
+        d = np.arange(req.n_dims)
+        strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])  # (pixels, dims, s)
+        stratum = strata[:, d, aij]  # (pixels, samples, dims)
         if req.offset == "cmj":
             subs = permute(np.arange(M, dtype=U32), M, (q * U32(SUBSTRATUM_KEY))[..., None])
-            sub = subs[local, d, u].astype(F32)
+            sub = subs[:, d, u].astype(F32)
         else:
             sub = F32((M - 1) / 2)
-        return oa.oa_value(i, strata[local, d, aij], sub, (q * U32(JITTER_KEY))[local, d], M, s, req.jitter)
+        i = req.samples[rect.k0 : rect.k1][None, :, None]
+        return oa.oa_value(i, stratum, sub, (q * U32(JITTER_KEY))[:, None, :], M, s, req.jitter)

@@ -7,7 +7,7 @@ import threading
 import numpy as np
 
 from .. import constructions, gf
-from ..request import Request
+from ..request import Rect, Request
 from .device import DeviceInfo, select_device
 from .program import build
 
@@ -18,6 +18,9 @@ GROUP_SIZE = 64
 #: Upper bound on one launch's output buffer (OpenCL buffers may not exceed
 #: 2 GiB, and CL_DEVICE_MAX_MEM_ALLOC_SIZE may be smaller still).
 MAX_CHUNK_BYTES = 256 << 20
+#: Longest first axis of a 2D table-path launch that is one work-group (see
+#: OpenCLBackend._axis).
+MAX_AXIS_GROUP = 1024
 
 
 class OpenCLBackend:
@@ -32,6 +35,8 @@ class OpenCLBackend:
     parallel_chunks = False
 
     def __init__(self, selector: str | None = None):
+        import pyopencl as cl
+
         self.info: DeviceInfo = select_device(selector)
         self.context, self.queue, self.program = build(self.info)
         self._lock = threading.Lock()
@@ -43,6 +48,11 @@ class OpenCLBackend:
         self._scratch_bufs: dict[str, object] = {}
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
+        self._axis_limit = min(
+            [MAX_AXIS_GROUP]
+            + [self._kernels[k].get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.info.device)
+               for k in ("tables", "generate_cells")]
+        )
 
     def describe(self) -> str:
         return self.info.describe()
@@ -88,6 +98,25 @@ class OpenCLBackend:
             buf = self._scratch_bufs[name] = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, size=max(nbytes, 4))
         return buf
 
+    def _launch_2d(self, name: str, n: int, n_pd: int, *args) -> None:
+        """Launch 2D kernel ``name`` over exactly ``n`` x ``n_pd`` work-items.
+
+        The table-path kernels have no bounds check: one would make their
+        loads conditional, and PoCL then neither hoists the per-(pixel,
+        dimension) loads out of its work-item loop nor vectorizes it
+        (docs/performance.md). So the first axis is never padded: one
+        work-group spans it when it fits, else groups of :data:`GROUP_SIZE`
+        cover the largest multiple and a second launch, with a global offset,
+        the rest. Called with self._lock held."""
+        kernel = self._kernels[name]
+        if n <= self._axis_limit:
+            kernel(self.queue, (n, n_pd), (n, 1), *args)
+            return
+        main = n // GROUP_SIZE * GROUP_SIZE
+        kernel(self.queue, (main, n_pd), (GROUP_SIZE, 1), *args)
+        if main < n:
+            kernel(self.queue, (n - main, n_pd), (n - main, 1), *args, global_offset=(main, 0))
+
     def rows_per_chunk(self, n_dims: int) -> int:
         return max(1, self.max_chunk_values // max(1, n_dims))
 
@@ -106,10 +135,10 @@ class OpenCLBackend:
             samples = cl.Buffer(self.context, ro, hostbuf=req.samples)
             dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
             buf = self._scratch("out", n_values * 4)
-            # Only the pixels of these rows travel to the device.
-            pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
-            pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
             if req.construction.family == "baseline":
+                # Only the pixels of these rows travel to the device.
+                pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
+                pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
                 a, b = (*req.construction.shape_args(prm), 0, 0)[:2]
                 self._kernels[f"generate_{req.construction.function}"](
                     self.queue, (_padded(n_values),), (GROUP_SIZE,),
@@ -121,37 +150,48 @@ class OpenCLBackend:
                 self.queue.finish()
                 return
             gf_args = (*self._field(req.construction.field_order(prm)), self._constants(req))
-            if req.tables_pay_off(row0, row1):
-                E = req.table_entries
-                n_entries = (pix1 - pix0) * req.n_dims * E
-                tab = self._scratch("tables", n_entries * 4)
-                self._kernels["tables"](
-                    self.queue, (_padded(n_entries),), (GROUP_SIZE,),
-                    tab, pixels, dims, np.uint32(n_entries), np.uint32(req.n_dims), np.uint32(E),
-                    np.uint32(req.seed), np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M),
-                )
-                kernel = self._kernels[f"generate_tabled_{req.construction.function}"]
-                # s^col of each CMJND column (all below 2**24); unused otherwise
-                pw = [prm.s**k for k in range(prm.block_dims)] if req.construction.name == "cmjnd" else [1]
-                powers = cl.Buffer(self.context, ro, hostbuf=np.array(pw, dtype=np.uint32))
-                kernel(
-                    self.queue, (_padded(n_values),), (GROUP_SIZE,),
-                    buf, tab, samples, dims, powers, np.uint32(n_s), np.uint32(req.n_dims),
-                    np.uint32(row0 - pix0 * n_s), np.uint32(n_values), np.uint32(E),
-                    np.uint32(prm.block_dims), np.uint32(prm.s), np.uint32(prm.M), np.uint32(prm.strength),
-                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter), *gf_args,
-                )
-            else:
+            for rect in req.rectangles(row0, row1):
+                # each rectangle's values are a contiguous part of the chunk
+                at = (rect.row0 - row0) * req.n_dims
+                if req.tables_pay_off(rect):
+                    self._launch_tabled(req, rect, buf, at)
+                    continue
+                pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[rect.pix0 : rect.pix1]))
+                n_rect = (rect.row1 - rect.row0) * req.n_dims
                 self._kernels["generate"](
-                    self.queue, (_padded(n_values),), (GROUP_SIZE,),
-                    buf, pixels, samples, dims,
-                    np.uint32(n_s), np.uint32(req.n_dims), np.uint32(row0 - pix0 * n_s), np.uint32(n_values),
+                    self.queue, (_padded(n_rect),), (GROUP_SIZE,),
+                    buf, np.uint32(at), pixels, samples, dims,
+                    np.uint32(n_s), np.uint32(req.n_dims), np.uint32(rect.row0 - rect.pix0 * n_s), np.uint32(n_rect),
                     np.uint32(req.seed), np.uint32(req.construction.code),
                     np.uint32(prm.s), np.uint32(prm.strength),
                     np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter), *gf_args,
                 )
             cl.enqueue_copy(self.queue, out, buf)
             self.queue.finish()
+
+    def _launch_tabled(self, req: Request, rect: Rect, buf, at: int) -> None:
+        """The table path over one rectangle: ``tables`` then ``generate_cells``,
+        writing values ``[at, at + rect values)`` of ``buf``. Called with
+        self._lock held."""
+        import pyopencl as cl
+
+        from .._numpy.oa import cells, table_keys
+
+        ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
+        prm = req.params
+        E, n_k, n_pd = req.table_entries, rect.n_k, rect.n_pixels * req.n_dims
+        keys = cl.Buffer(self.context, ro, hostbuf=table_keys(req, rect.pix0, rect.pix1))
+        tab = self._scratch("tables", n_pd * E * 4)
+        self._launch_2d("tables", E, n_pd, tab, keys, np.uint32(E), np.uint32(prm.s), np.uint32(prm.M))
+        aij, u = cells(req, rect.k0, rect.k1)
+        self._launch_2d(
+            "generate_cells", n_k, n_pd,
+            buf, np.uint32(at), tab,
+            cl.Buffer(self.context, ro, hostbuf=aij), cl.Buffer(self.context, ro, hostbuf=u),
+            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1])),
+            np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(prm.s), np.uint32(prm.M),
+            np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+        )
 
 
 def _field_tables(q: int) -> tuple[np.ndarray, bool]:
@@ -167,3 +207,4 @@ def _field_tables(q: int) -> tuple[np.ndarray, bool]:
 def _padded(n: int) -> int:
     """``n`` rounded up to a multiple of :data:`GROUP_SIZE`."""
     return -(-n // GROUP_SIZE) * GROUP_SIZE
+

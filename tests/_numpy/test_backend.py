@@ -16,8 +16,10 @@ def test_table_path_and_direct_path_agree(offset):
     full = smp.generate(pixels=[0, 1])  # 64 samples per pixel: tables for cmj/centered
     one_by_one = np.concatenate([smp.generate(pixels=[0, 1], samples=[i]) for i in range(64)], axis=1)
     assert_same_bits(full, one_by_one)
-    assert smp._request([0], range(64), None).tables_pay_off(0, 64) == (offset in ("cmj", "centered"))
-    assert not smp._request([0], [5], None).tables_pay_off(0, 1)
+    req = smp._request([0], range(64), None)
+    assert req.tables_pay_off(*req.rectangles(0, 64)) == (offset in ("cmj", "centered"))
+    req = smp._request([0], [5], None)
+    assert not req.tables_pay_off(*req.rectangles(0, 1))
     assert_same_bits(full[:, ::9], reference_block(smp, [0, 1], range(0, 64, 9), range(6)))
 
 

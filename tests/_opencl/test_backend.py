@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import pyoa
-from tests.helpers import assert_same_bits
+from tests.helpers import assert_same_bits, reference_block
 
 pytestmark = pytest.mark.opencl
 
@@ -67,3 +67,32 @@ def test_index2_constants_and_fields_follow_each_sampler(opencl):
             assert smp._backend is opencl
             want = pyoa.sampler(name, spp=spp, dims=9, seed=3, offset=offset, backend="numpy").generate(pixels=[0, 5])
             assert_same_bits(smp.generate(pixels=[0, 5]), want, f"{name} spp={spp} {offset}")
+
+
+@pytest.mark.parametrize("offset", ["cmj", "centered"])
+def test_table_path_splits_long_axes_and_partial_pixels(monkeypatch, opencl, offset):
+    """The table kernels have no bounds check, so _launch_2d covers an axis longer
+    than one work-group with full groups plus a remainder launch at a global
+    offset (Bose s=37: 1369 samples = 21 x 64 + 25). With a chunk of 1.5 pixels
+    every chunk is a head, whole-pixel and tail rectangle, each on the table path.
+    Same bits as NumPy, and as the reference at the seams."""
+    from pyoa.request import Rect
+
+    n = 1369
+    kw = dict(spp=n, dims=7, seed=5, offset=offset)
+    smp = pyoa.sampler("bose", backend="opencl", **kw)
+    assert n > smp._backend._axis_limit and n % 64  # both launches of _launch_2d
+    pixels = [3, 2**32 - 1, 0, 17]
+    want = pyoa.sampler("bose", backend="numpy", **kw).generate(pixels=pixels)
+    assert_same_bits(smp.generate(pixels=pixels), want, "whole pixels")
+
+    monkeypatch.setattr(smp._backend, "max_chunk_values", 7 * (n + n // 2))
+    launched = []
+    real = smp._backend._launch_tabled
+    monkeypatch.setattr(smp._backend, "_launch_tabled", lambda req, rect, *a: (launched.append(rect), real(req, rect, *a)))
+    got = smp.generate(pixels=pixels)
+    assert_same_bits(got, want, "chunks of 1.5 pixels")
+    assert Rect(n + n // 2, 2 * n, 1, 2, n // 2, n) in launched  # a tail, tabled
+    assert any(r.n_k == n and r.n_pixels == 1 for r in launched)
+    seams = [0, n // 2 - 1, n // 2, n // 2 + 1, 1343, 1344, n - 1]
+    assert_same_bits(got[:, seams], reference_block(smp, pixels, seams, range(7)), "vs reference")
