@@ -62,28 +62,72 @@ __kernel void generate(__global float *out,
  * neither kernel has a bounds check: one makes the loads conditional, and
  * PoCL then neither hoists the uniform ones nor vectorizes. */
 
-/* tables: axis 0 is the entry e of (pixel, dimension) pd's table. keys holds
+/* tables: axis 0 is the entry e of (pixel, dimension) pd's table, whose E
+ * entries start at pd * Es: Es is E rounded up to a multiple of 8, so that
+ * the axis is whole 8-lane vectors (PoCL runs a remainder scalar; with E = 23
+ * the 7 scalar lanes cost more than the 16 vector ones). The padding entries
+ * are written with 0 and never read. keys holds
  * per pd the column key q and the final shifts q * STRATUM_KEY % s and
  * q * SUBSTRATUM_KEY % M (pyoa._numpy.oa.table_keys): computed on the host,
  * they cost PoCL more here than the cycle walks themselves, even as loop
- * invariants (docs/performance.md). */
-__kernel void tables(__global uint *tab,
-                     __global const uint *keys,
+ * invariants (docs/performance.md).
+ *
+ * permute(i, l, p) = (walk(i) + p % l) % l with walk(i) < l, so the last %
+ * is a subtraction. A loop keeps PoCL from vectorizing a kernel, so the walk
+ * runs in two launches: `tables` takes TABLE_ROUNDS rounds for every entry
+ * (straight-line, 8 lanes wide), which ends the walk of most entries, and
+ * stores the others' walk state with WALK_PENDING set; `tables_finish`
+ * walks those on to the end (a loop, but over few entries). The jitter-seed
+ * slot walks from 0: a walk must start in [0, l), or it may never return. */
+#define TABLE_ROUNDS 3
+#define WALK_PENDING 0x80000000u
+
+__attribute__((always_inline)) uint walk_step(uint x, uint l, uint p, uint w)
+{
+    uint y = permute_round(x, p, w);
+    return (x < l) ? x : y;
+}
+
+__kernel void tables(__global uint *restrict tab,
+                     __global const uint *restrict keys,
                      const uint E,
+                     const uint Es,
                      const uint s,
                      const uint M)
 {
     uint e = (uint)get_global_id(0), pd = (uint)get_global_id(1);
     uint q = keys[3u * pd], cS = keys[3u * pd + 1u], cU = keys[3u * pd + 2u];
-    /* permute(i, l, p) = (walk(i) + p % l) % l with walk(i) < l, so the last
-     * % is a subtraction. The jitter-seed slot walks from 0: a walk must
-     * start in [0, l), or it may never return there. */
+    uint wS = walk_mask(s), wU = walk_mask(M);
     uint stratum = e < s;
     uint l = stratum ? s : M, p = q * (stratum ? STRATUM_KEY : SUBSTRATUM_KEY), c = stratum ? cS : cU;
-    uint i = stratum ? e : (e + 1u == E) ? 0u : e - s;
-    uint x = permute_walk(i, l, p, walk_mask(l)) + c;
-    x = (x >= l) ? x - l : x;
-    tab[pd * E + e] = (e + 1u == E) ? q * JITTER_KEY : p ? x : i;
+    uint w = stratum ? wS : wU;
+    uint i = stratum ? e : (e + 1u >= E) ? 0u : e - s;
+    /* TABLE_ROUNDS = 3 rounds, written out: a loop, even of constant trip
+     * count, is still there when PoCL builds its work-item loop */
+    uint x = walk_step(walk_step(permute_round(i, p, w), l, p, w), l, p, w);
+    uint v = x + c;
+    v = (x >= l) ? (x | WALK_PENDING) : (v >= l) ? v - l : v;
+    tab[pd * Es + e] = (e + 1u == E) ? q * JITTER_KEY : (e >= E) ? 0u : p ? v : i;
+}
+
+/* Finishes the walks `tables` left pending (same launch shape). Entries
+ * below l never have WALK_PENDING set (l <= 2^31), and the jitter slot is
+ * skipped by position, so a finished entry is never touched again. */
+__kernel void tables_finish(__global uint *restrict tab,
+                            __global const uint *restrict keys,
+                            const uint E,
+                            const uint Es,
+                            const uint s,
+                            const uint M)
+{
+    uint e = (uint)get_global_id(0), pd = (uint)get_global_id(1);
+    uint g = pd * Es + e, v = tab[g];
+    if (!(v & WALK_PENDING) || e + 1u >= E) return;
+    uint q = keys[3u * pd];
+    uint stratum = e < s;
+    uint l = stratum ? s : M, p = q * (stratum ? STRATUM_KEY : SUBSTRATUM_KEY);
+    uint x = permute_walk(v & ~WALK_PENDING, l, p, walk_mask(l)) + keys[3u * pd + (stratum ? 1u : 2u)];
+    tab[g] = (x >= l) ? x - l : x;
 }
 
 /* generate_cells: axis 0 is the sample position k in [0, n_k). The cells
@@ -92,25 +136,32 @@ __kernel void tables(__global uint *tab,
  * (pyoa._numpy.oa.cells), laid out [d][k], so that every construction shares
  * this one straight-line kernel and its loads along k are contiguous.
  * 'centered' passes cell_u = 0 and reads (and ignores) slot s. */
-__kernel void generate_cells(__global float *out,
+__kernel void generate_cells(__global float *restrict out,
                              const uint out0,
-                             __global const uint *tab,
-                             __global const uint *cell_a,
-                             __global const uint *cell_u,
-                             __global const uint *isamp,
+                             __global const uint *restrict tab,
+                             __global const uint *restrict cell_a,
+                             __global const uint *restrict cell_u,
+                             __global const uint *restrict isamp,
                              const uint n_k,
                              const uint n_dims,
                              const uint E,
+                             const uint Es,
                              const uint s,
                              const uint M,
                              const uint offset,
                              const float J)
 {
     uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);
-    uint d = pd % n_dims, pl = pd / n_dims, base = pd * E;
+    uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;
     uint c = d * n_k + k;
     float sub = (offset == OFFSET_CMJ) ? convert_float(tab[base + s + cell_u[c]]) : 0.5f * convert_float(M - 1u);
-    out[out0 + (pl * n_k + k) * n_dims + d] = oa_value(isamp[k], tab[base + cell_a[c]], sub, tab[base + E - 1u], M, s, J);
+    /* The store's stride is n_dims. Written as k * n_dims, LLVM versions the
+     * work-item loop on "n_dims == 1" and runs the scalar copy for every
+     * other n_dims (3x slower, docs/performance.md); with the top bit set in
+     * the multiplier and masked off again it sees no plain stride. The mask
+     * is exact: k * n_dims < 2^31 (a launch writes fewer values). */
+    uint row = (k * (n_dims | 0x80000000u)) & 0x7fffffffu;
+    out[out0 + pl * n_k * n_dims + row + d] = oa_value(isamp[k], tab[base + cell_a[c]], sub, tab[base + E - 1u], M, s, J);
 }
 
 /* The comparison samplers: one kernel each, one work-item per value. a and b

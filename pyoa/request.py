@@ -67,17 +67,25 @@ class Request:
             r = r1
         return rects
 
+    @property
+    def table_stride(self) -> int:
+        """:attr:`table_entries` rounded up to a multiple of 8: the OpenCL
+        kernels lay tables out with this stride so that a table is whole
+        8-lane vectors (``kernels/generate.cl``)."""
+        return -(-self.table_entries // 8) * 8
+
     def tables_pay_off(self, rect: "Rect") -> bool:
         """Whether rectangle ``rect`` should use the table path.
 
         The table path (``cmj`` and ``centered`` only) first computes
         :attr:`table_entries` values per (pixel, dimension), then gathers one
-        per value. It pays off when a table is no longer than the rectangle's
-        run of samples, i.e. the tables are no larger than the output; the
-        same bound keeps the table buffer within the chunk size limits the
-        backends already respect.
+        per value. It pays off when a table (with its padding,
+        :attr:`table_stride`) is no longer than the rectangle's run of
+        samples, i.e. the tables are no larger than the output; the same bound
+        keeps the table buffer within the chunk size limits the backends
+        already respect.
         """
-        return self.offset in ("cmj", "centered") and self.table_entries <= rect.n_k
+        return self.offset in ("cmj", "centered") and self.table_stride <= rect.n_k
 
 
 @dataclass(frozen=True)

@@ -433,7 +433,7 @@ def test_index2_table_path_at_the_largest_sizes(backend, name, s, offset, monkey
     path, and as the reference on a subset."""
     N, d = 2 * s * s, 2 * s + 1
     smp = pyoa.sampler(name, spp=N, dims=2 * d + 1, seed=12, offset=offset, backend=backend)
-    n = smp._request([0], [0], None).table_entries + 3
+    n = smp._request([0], [0], None).table_stride + 3
     start = s * s - n // 2 if name == "addelman-kempthorne" else N - n
     samples = range(start, start + n)
     dims = [0, 1, s - 1, s, 2 * s - 1, 2 * s, d, 2 * d]

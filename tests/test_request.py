@@ -37,10 +37,11 @@ def test_rectangles_tile_the_rows(case):
 
 
 def test_table_path_needs_a_run_of_samples_as_long_as_a_table():
-    smp = pyoa.sampler("bose", spp=121, dims=3)  # cmj: tables of 11 + 11 + 1 entries
+    smp = pyoa.sampler("bose", spp=121, dims=3)  # cmj: tables of 11 + 11 + 1 entries, stride 24
     req = smp._request([0, 1], None, None)
-    head, whole = req.rectangles(121 - 23, 242)
+    assert (req.table_entries, req.table_stride) == (23, 24)
+    head, whole = req.rectangles(121 - 24, 242)
     assert req.tables_pay_off(head) and req.tables_pay_off(whole)
-    assert not req.tables_pay_off(req.rectangles(121 - 22, 121)[0])
+    assert not req.tables_pay_off(req.rectangles(121 - 23, 121)[0])
     jit = pyoa.sampler("bose", spp=121, dims=3, offset="j")._request([0], None, None)
     assert not jit.tables_pay_off(jit.rectangles(0, 121)[0])

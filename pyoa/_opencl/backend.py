@@ -51,7 +51,7 @@ class OpenCLBackend:
         self._axis_limit = min(
             [MAX_AXIS_GROUP]
             + [self._kernels[k].get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.info.device)
-               for k in ("tables", "generate_cells")]
+               for k in ("tables", "tables_finish", "generate_cells")]
         )
 
     def describe(self) -> str:
@@ -181,15 +181,17 @@ class OpenCLBackend:
         prm = req.params
         E, n_k, n_pd = req.table_entries, rect.n_k, rect.n_pixels * req.n_dims
         keys = cl.Buffer(self.context, ro, hostbuf=table_keys(req, rect.pix0, rect.pix1))
-        tab = self._scratch("tables", n_pd * E * 4)
-        self._launch_2d("tables", E, n_pd, tab, keys, np.uint32(E), np.uint32(prm.s), np.uint32(prm.M))
+        Es = req.table_stride  # E padded to whole vectors (kernels/generate.cl)
+        tab = self._scratch("tables", n_pd * Es * 4)
+        for name in ("tables", "tables_finish"):
+            self._launch_2d(name, Es, n_pd, tab, keys, np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M))
         aij, u = cells(req, rect.k0, rect.k1)
         self._launch_2d(
             "generate_cells", n_k, n_pd,
             buf, np.uint32(at), tab,
             cl.Buffer(self.context, ro, hostbuf=aij), cl.Buffer(self.context, ro, hostbuf=u),
             cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1])),
-            np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(prm.s), np.uint32(prm.M),
+            np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M),
             np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
         )
 
