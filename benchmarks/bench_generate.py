@@ -36,6 +36,33 @@ construction and offset, and the comparison samplers); that takes about 15
 minutes, so they are opt-in. ``--cases baselines`` runs the six comparison
 samplers (about 6 minutes with the default case).
 
+Peers
+-----
+When the required case is among the cases, the same run also measures peer
+implementations of the same workload (N = 121 points per pixel, 10
+dimensions), so the ratios in the report are measured side by side, not
+quoted (``peers.py``; ``--no-peers`` turns them off):
+
+- SciPy's ``scipy.stats.qmc.LatinHypercube(d=10, strength=2, rng=seed)``
+  (an OA-based Latin hypercube): one ``.random(121)`` call is one pixel's
+  point set. It builds the array in Python loops, so after one warm-up call
+  it is timed for ``--peer-budget`` seconds (3 s; 0.5 s with ``--quick``),
+  as many calls as fit; values/s = calls x 121 x 10 / elapsed, and the full
+  65,536-pixel time is extrapolated from it.
+- Mitsuba 3's samplers ``orthogonal``, ``independent``, ``multijitter`` and
+  ``ldsampler`` on the ``llvm_ad_rgb`` variant, if ``mitsuba`` is
+  importable, each in its own subprocess (an LLVM abort must not take the
+  benchmark down): ``seed(seed, wavefront_size=P * spp)`` after
+  ``set_samples_per_wavefront(spp)`` (as Mitsuba's render loop does), then
+  ten ``next_1d()`` draws, ``dr.eval`` and ``np.asarray``; one warm-up (JIT
+  compilation), then the median of ``--repeats`` runs; values/s =
+  P x spp x 10 / median. P is ``--peer-pixels`` (default: ``--pixels``).
+
+A peer that cannot run is listed as ``skipped`` (not installed, or SciPy
+rejects the configuration) or ``failed`` (the subprocess's exit status and
+first line of stderr), never silently left out. Peers never change the exit
+status.
+
 Noise
 -----
 On the 2-core PoCL machines this project is measured on, the same workload
@@ -60,6 +87,7 @@ Usage::
     python benchmarks/bench_generate.py --cases all     # every case
     python benchmarks/bench_generate.py --cases default,baselines  # Bose and the comparison samplers
     python benchmarks/bench_generate.py --backends opencl --repeats 9
+    python benchmarks/bench_generate.py --no-peers      # pyoa rows only
 """
 
 from __future__ import annotations
@@ -87,10 +115,14 @@ except ImportError as _exc:  # pragma: no cover - environment problem
     sys.exit(f"bench_generate: cannot import pyoa ({_exc}); install it first: pip install -e .")
 
 REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py, shared with bench_render.py
+import peers  # noqa: E402
 DEFAULT_OUT = REPO / "benchmarks" / "results" / "generate.json"
 FULL_PIXELS = 65536
 QUICK_PIXELS = 4096
-SCHEMA = 1
+SCHEMA = 2  # 2: the "peers" list
+PEER_BUDGET_S = 3.0
+QUICK_PEER_BUDGET_S = 0.5
 
 #: name -> sampler parameters. ``bose-cmj-121x10`` is the required workload.
 CASES: dict[str, dict] = {
@@ -238,7 +270,22 @@ def _fail(entry: dict, status: str, exc: Exception) -> None:
     _log(f"  {entry['case']:<22} {entry['backend']:<7} {status.upper()}: {entry['reason']}")
 
 
-def prepare(case: str, backend: str, pixels: int, seed: int) -> tuple[dict, object]:
+#: Output arrays reused across timed calls, one per shape (see ``--fresh-output``).
+_OUTPUTS: dict[tuple, np.ndarray] = {}
+
+
+def _output(entry: dict, fresh: bool):
+    """The ``out=`` argument of a timed call: None (generate allocates a new
+    array) with ``fresh``, else one array per shape, reused by every call."""
+    if fresh:
+        return None
+    shape = (entry["pixels"], entry["spp"], entry["dims"])
+    if shape not in _OUTPUTS:
+        _OUTPUTS[shape] = np.empty(shape, np.float32)
+    return _OUTPUTS[shape]
+
+
+def prepare(case: str, backend: str, pixels: int, seed: int, fresh: bool = False) -> tuple[dict, object]:
     """Create the sampler and run the untimed-for-the-median warm-up; never raises for a backend failure.
 
     Returns the result entry and the sampler (None when skipped or failed).
@@ -261,7 +308,7 @@ def prepare(case: str, backend: str, pixels: int, seed: int) -> tuple[dict, obje
     entry.update(_opencl_details(smp))
     try:
         t0 = time.perf_counter()
-        x = smp.generate(pixels=range(pixels))
+        x = smp.generate(pixels=range(pixels), out=_output(entry, fresh))
         entry["warmup_s"] = time.perf_counter() - t0
         entry["digest"] = _digest(x)
         del x
@@ -272,11 +319,12 @@ def prepare(case: str, backend: str, pixels: int, seed: int) -> tuple[dict, obje
     return entry, smp
 
 
-def timed_run(entry: dict, smp, k: int, repeats: int) -> bool:
+def timed_run(entry: dict, smp, k: int, repeats: int, fresh: bool = False) -> bool:
     """One timed ``generate``; appends to ``entry['times_s']``. False (and the entry marked failed) on error."""
     try:
+        out = _output(entry, fresh)
         t0 = time.perf_counter()
-        x = smp.generate(pixels=range(entry["pixels"]))
+        x = smp.generate(pixels=range(entry["pixels"]), out=out)
         dt = time.perf_counter() - t0
         del x  # one result array alive at a time
     except Exception as exc:  # noqa: BLE001
@@ -298,17 +346,18 @@ def summarize(entry: dict) -> dict:
     return entry
 
 
-def bench(cases: list[str], backends: list[str], pixels: int, repeats: int, seed: int) -> list[dict]:
+def bench(cases: list[str], backends: list[str], pixels: int, repeats: int, seed: int,
+          fresh: bool = False) -> list[dict]:
     """Warm up every (case, backend), then time them round-robin, ``repeats`` rounds.
 
     Interleaving spreads a transient slowdown of the machine (another process,
     a noisy neighbour) over every row instead of one, so the rows of one run
     stay comparable with each other.
     """
-    pairs = [prepare(case, backend, pixels, seed) for case in cases for backend in backends]
+    pairs = [prepare(case, backend, pixels, seed, fresh) for case in cases for backend in backends]
     for k in range(repeats):
         for i, (entry, smp) in enumerate(pairs):
-            if smp is not None and not timed_run(entry, smp, k, repeats):
+            if smp is not None and not timed_run(entry, smp, k, repeats, fresh):
                 pairs[i] = (entry, None)
     return [summarize(entry) for entry, _ in pairs]
 
@@ -325,6 +374,70 @@ def _load(avg) -> str:
     return " / ".join(f"{v:.2f}" for v in avg) if avg else "unknown"
 
 
+def _rate(v: float) -> str:
+    """M values/s with three significant figures or more: 173.2, 4.51, 0.403."""
+    m = v / 1e6
+    return f"{m:,.1f}" if m >= 100 else f"{m:.3g}" if m >= 0.001 else f"{m:.2e}"
+
+
+def _ratio(a: float | None, b: float | None) -> str:
+    if not a or not b:
+        return ""
+    r = a / b
+    return f"{r:,.0f}x" if r >= 100 else f"{r:.1f}x" if r >= 1 else f"{r:.2f}x"
+
+
+def _peer_details(p: dict) -> str:
+    d = p["details"]
+    if p["status"] != "ok":
+        return p["reason"] or ""
+    if "calls" in d:  # SciPy
+        return (f"scipy {d['scipy']}, `{d['call']}`: {d['calls']:,} calls in {d['elapsed_s']:.2f} s; per call "
+                f"median {1e3 * d['median_call_s']:.2f} ms (min {1e3 * d['min_call_s']:.2f}, "
+                f"max {1e3 * d['max_call_s']:.2f}); float64 output")
+    spp = f"{d['sample_count']} spp" + (f" (asked {d['requested_spp']})" if d["sample_count"] != d["requested_spp"]
+                                        else "")
+    px = f"{d['pixels']:,} pixels" + (f" (asked {d['requested_pixels']:,})" if d["pixels"] != d["requested_pixels"]
+                                      else "")
+    runs = len(d["times_s"])
+    return (f"Mitsuba {d['version']} `{d['variant']}`, {px} x {spp} x {d['dims']} dims; median of {runs} "
+            f"run{'s' if runs != 1 else ''} {d['median_s']:.3f} s (min {d['min_s']:.3f}, max {d['max_s']:.3f}), "
+            f"warm-up {d['warmup_s']:.2f} s")
+
+
+def peers_markdown(report: dict) -> list[str]:
+    """The "Peers (same run)" section: each peer's rate and pyoa's (required case, this run) over it."""
+    cfg = report["config"]
+    lines = ["", "Peers (same run):", ""]
+    if not cfg["peers"]:
+        return lines + [f"Not run: {cfg['peers_note']}."]
+    pyoa_rate = {r["backend"]: r.get("median_values_per_s") for r in report["results"]
+                 if r["case"] == REQUIRED_CASE}
+    spec = CASES[REQUIRED_CASE]
+    runs = f"{cfg['repeats']} run{'s' if cfg['repeats'] != 1 else ''}"
+    lines += [
+        f"The `{REQUIRED_CASE}` workload ({spec['spp']} points per pixel, {spec['dims']} dimensions) by other "
+        f"implementations, timed in this process after pyoa's rows. Ratios divide pyoa's median M values/s "
+        f"from the table above by the peer's. SciPy: as many `.random({spec['spp']})` calls (one pixel each) "
+        f"as fit in {cfg['peer_budget_s']:g} s after one warm-up call. The est. s column is the time the "
+        f"full workload ({FULL_PIXELS:,} pixels x {spec['spp']} x {spec['dims']}) would take at the peer's rate. "
+        f"Mitsuba: {cfg['peer_pixels']:,} pixels in one wavefront per run, median of {runs} after a warm-up.",
+        "",
+        f"| peer | status | M values/s | pyoa OpenCL / peer | pyoa NumPy / peer | est. s, {FULL_PIXELS:,} px | "
+        "details |",
+        "|---|---|---:|---:|---:|---:|---|",
+    ]
+    for p in report["peers"]:
+        rate = p["values_per_s"]
+        full = p["details"].get("full_workload_s")
+        lines.append(
+            f"| {p['name']} | {p['status']} | {_rate(rate) if rate else ''} | "
+            f"{_ratio(pyoa_rate.get('opencl'), rate)} | {_ratio(pyoa_rate.get('numpy'), rate)} | "
+            f"{f'{full:,.1f}' if full else ''} | {_peer_details(p)} |"
+        )
+    return lines
+
+
 def markdown(report: dict) -> str:
     meta, cfg = report["machine"], report["config"]
     lines = ["# pyoa generate benchmark", ""]
@@ -335,7 +448,10 @@ def markdown(report: dict) -> str:
         lines += [f"**Reduced workload**: {cfg['pixels']:,} pixels instead of {FULL_PIXELS:,}.", ""]
     lines += [
         f"Median of {cfg['repeats']} timed `Sampler.generate(pixels=range({cfg['pixels']}))` calls after one "
-        f"warm-up, seed {cfg['seed']}; M values/s = values / median seconds. Process-to-process noise "
+        f"warm-up, seed {cfg['seed']}, "
+        + ("each allocating its result (`--fresh-output`)" if cfg.get("fresh_output")
+           else "each writing into one reused `out=` array") +
+        "; M values/s = values / median seconds. Process-to-process noise "
         "on this machine kind is 15-25 %: compare rows of this table, not separate runs.",
         "",
         "| case | backend | values | median s | M values/s | min s | max s | spread | vs numpy |",
@@ -359,6 +475,7 @@ def markdown(report: dict) -> str:
         notes.append(f"- {case}: backends gave {'identical' if same else 'DIFFERENT'} bits (BLAKE2b of the output)")
     if notes:
         lines += ["", *notes]
+    lines += peers_markdown(report)
     lines += ["", "Cases:", ""]
     for case in cfg["cases"]:
         spec = CASES[case]
@@ -445,6 +562,16 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--out", type=Path, default=DEFAULT_OUT,
                     help="JSON result path; the Markdown table goes beside it with suffix .md "
                          "(default: benchmarks/results/generate.json)")
+    ap.add_argument("--no-peers", dest="peers", action="store_false",
+                    help="do not time the peers (SciPy's OA-LHS, Mitsuba 3's samplers)")
+    ap.add_argument("--peer-budget", type=float, default=None,
+                    help=f"seconds of timed SciPy LatinHypercube calls (default: {PEER_BUDGET_S:g}; "
+                         f"{QUICK_PEER_BUDGET_S:g} with --quick)")
+    ap.add_argument("--peer-pixels", type=int, default=None,
+                    help="pixels per Mitsuba wavefront (x spp samples; default: --pixels)")
+    ap.add_argument("--fresh-output", action="store_true",
+                    help="let every timed generate allocate its result (default: one reused out= array per "
+                         "shape, faulted in by the warm-up: the issue's 'copy into a reused host array')")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
     args = ap.parse_args(argv)
     if args.repeats < 1:
@@ -453,6 +580,14 @@ def parse_args(argv=None) -> argparse.Namespace:
         args.pixels = QUICK_PIXELS if args.quick else FULL_PIXELS
     if args.pixels < 1:
         ap.error("--pixels must be at least 1")
+    if args.peer_budget is None:
+        args.peer_budget = QUICK_PEER_BUDGET_S if args.quick else PEER_BUDGET_S
+    if not args.peer_budget > 0:
+        ap.error("--peer-budget must be positive")
+    if args.peer_pixels is None:
+        args.peer_pixels = args.pixels
+    if args.peer_pixels < 1:
+        ap.error("--peer-pixels must be at least 1")
     return args
 
 
@@ -473,7 +608,14 @@ def main(argv=None) -> int:
          f"{meta['cpu_count']} cores; {args.pixels:,} pixels, {args.repeats} repeats"
          + (" [QUICK]" if args.quick else ""))
     load_start = _loadavg()
-    results = bench(args.cases, args.backends, args.pixels, args.repeats, args.seed)
+    results = bench(args.cases, args.backends, args.pixels, args.repeats, args.seed, args.fresh_output)
+    run_peers = args.peers and REQUIRED_CASE in args.cases
+    peer_results: list[dict] = []
+    if run_peers:
+        spec = CASES[REQUIRED_CASE]
+        peer_results = peers.run_peers(spec["spp"], spec["dims"], pixels=args.peer_pixels,
+                                       budget_s=args.peer_budget, repeats=args.repeats, seed=args.seed,
+                                       full_pixels=FULL_PIXELS, log=_log)
     meta["loadavg_start"], meta["loadavg_end"] = load_start, _loadavg()
     bits_match = {}
     for case in args.cases:
@@ -488,10 +630,15 @@ def main(argv=None) -> int:
                   "time.perf_counter around generate only; cases and backends interleaved round-robin",
         "config": {"cases": args.cases, "backends": args.backends, "pixels": args.pixels,
                    "repeats": args.repeats, "seed": args.seed, "quick": args.quick,
-                   "full_workload": args.pixels == FULL_PIXELS},
+                   "fresh_output": args.fresh_output,
+                   "full_workload": args.pixels == FULL_PIXELS,
+                   "peers": run_peers, "peer_budget_s": args.peer_budget, "peer_pixels": args.peer_pixels,
+                   "peers_note": None if run_peers else "--no-peers" if not args.peers else
+                   f"the required case {REQUIRED_CASE} is not among the cases"},
         "machine": meta,
         "results": results,
         "bits_match": bits_match,
+        "peers": peer_results,
         "total_s": time.perf_counter() - t_start,
     }
     md = markdown(report)

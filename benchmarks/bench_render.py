@@ -37,9 +37,11 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py, shared with bench_generate.py
 
 import numpy as np  # noqa: E402
 
+import peers  # noqa: E402
 import pyoa  # noqa: E402
 from pyoa.atomic import atomic_path  # noqa: E402
 from pyoa.render.render import render  # noqa: E402
@@ -71,20 +73,12 @@ print(json.dumps({"status": "ok", "version": mi.__version__, "times_s": times, "
 
 def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, repeats: int) -> dict:
     """Mitsuba 3's ``orthogonal`` sampler on its own ``cornell_box()``, in a
-    subprocess (a Dr.Jit/LLVM failure must not take this benchmark down)."""
-    import importlib.util
-    import subprocess
-
-    if importlib.util.find_spec("mitsuba") is None:
+    subprocess (a Dr.Jit/LLVM failure must not take this benchmark down; ``peers.run_json_script``)."""
+    if not peers.mitsuba_available():
         return {"status": "skipped", "reason": "mitsuba is not installed (pip install mitsuba)"}
     if scene != "cornell":
         return {"status": "skipped", "reason": "only the cornell scene has a Mitsuba twin"}
-    proc = subprocess.run([sys.executable, "-c", _MITSUBA, str(width), str(height), str(spp), str(depth),
-                           str(repeats)], capture_output=True, text=True)
-    if proc.returncode != 0:
-        tail = (proc.stderr or proc.stdout).strip().splitlines()
-        return {"status": "failed", "reason": f"exit {proc.returncode}: {tail[0] if tail else ''}"[:300]}
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return peers.run_json_script(_MITSUBA, [width, height, spp, depth, repeats])
 
 
 def main(argv=None) -> int:

@@ -213,7 +213,8 @@ class Sampler:
             dims=_indices("dims", dims, self.dims, range(self.dims)),
         )
 
-    def generate(self, pixels=None, samples=None, dims=None, *, progress: bool = False) -> np.ndarray:
+    def generate(self, pixels=None, samples=None, dims=None, *, out: np.ndarray | None = None,
+                 progress: bool = False) -> np.ndarray:
         """Generate a block of values in bulk.
 
         Parameters
@@ -224,22 +225,30 @@ class Sampler:
             Sample indices in ``[0, spp)``; default every sample.
         dims : range or sequence of int, optional
             Dimensions in ``[0, dims)``; default every dimension.
+        out : numpy.ndarray, optional
+            Where to write the result, as NumPy's ``out=``: a C-contiguous,
+            writeable float32 array of the result's shape. Reusing one array
+            across calls saves allocating (and the kernel faulting in) fresh
+            pages every time (``docs/performance.md``).
         progress : bool
             Show a tqdm progress bar over the chunks of a large request.
 
         Returns
         -------
         numpy.ndarray
-            C-contiguous float32 of shape ``(len(pixels), len(samples), len(dims))``;
-            ``out[a, b, c] == x(pixels[a], samples[b], dims[c])``, bit for bit
+            C-contiguous float32 of shape ``(len(pixels), len(samples), len(dims))``
+            (``out`` itself when given);
+            ``result[a, b, c] == x(pixels[a], samples[b], dims[c])``, bit for bit
             whatever the backend or the way the request is split.
 
         Raises
         ------
         ValueError
-            An index out of range, or a request larger than ``max_bytes``.
+            An index out of range, a request larger than ``max_bytes``, or an
+            ``out`` of the wrong shape.
         TypeError
-            An argument that is not a range or a sequence of ints.
+            An argument that is not a range or a sequence of ints, or an
+            ``out`` that is not a writeable C-contiguous float32 ndarray.
         """
         req = self._request(pixels, samples, dims)
         shape = (len(req.pixels), len(req.samples), req.n_dims)
@@ -250,7 +259,7 @@ class Sampler:
                 f"over the memory limit of {_fmt_bytes(self.max_bytes)}; ask for fewer pixels at a time, "
                 f"or raise the limit with max_bytes= or ${ENV_MAX_BYTES}"
             )
-        out = np.empty(shape, dtype=np.float32)
+        out = _output(out, shape)
         rows = out.reshape(req.n_rows, req.n_dims)
         step = self._backend.rows_per_chunk(req.n_dims)
         chunks = [(r0, min(r0 + step, req.n_rows)) for r0 in range(0, req.n_rows, step)]
@@ -293,6 +302,22 @@ class Sampler:
         j = _int("j", j, 0, self.dims - 1)
         p = reference.pixel_seed(self.seed, pixel)
         return float(self._construction.call("pyoa.reference", i, j, self.params, p, self.offset, self.jitter))
+
+
+def _output(out, shape: tuple[int, ...]) -> np.ndarray:
+    """``out`` checked as the destination of a result of ``shape``, or a new array."""
+    if out is None:
+        return np.empty(shape, dtype=np.float32)
+    if not isinstance(out, np.ndarray):
+        raise TypeError(f"out must be a numpy.ndarray, got {type(out).__name__}")
+    if out.dtype != np.float32 or not out.flags.c_contiguous or not out.flags.writeable:
+        raise TypeError(
+            f"out must be a writeable C-contiguous float32 array, got dtype={out.dtype}, "
+            f"C-contiguous={out.flags.c_contiguous}, writeable={out.flags.writeable}"
+        )
+    if out.shape != shape:
+        raise ValueError(f"out has shape {out.shape}; this request needs {shape} (pixels, samples, dims)")
+    return out
 
 
 def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None = None, jitter: float = 1.0,

@@ -46,6 +46,40 @@ def test_shape_dtype_contiguity(smp):
         assert np.all((x >= 0) & (x < 1))
 
 
+def test_out_array_is_filled_and_returned(smp):
+    """generate(out=...) writes the same bits into the caller's array and returns it;
+    reusing one array gives each call's own values (nothing left from the last)."""
+    want = smp.generate(pixels=[3, 4], samples=range(5), dims=[0, 2])
+    out = np.full((2, 5, 2), np.nan, dtype=np.float32)
+    assert smp.generate(pixels=[3, 4], samples=range(5), dims=[0, 2], out=out) is out
+    assert_same_bits(out, want)
+    other = smp.generate(pixels=[9, 10], samples=range(5), dims=[0, 2])
+    assert smp.generate(pixels=[9, 10], samples=range(5), dims=[0, 2], out=out) is out
+    assert_same_bits(out, other)
+    whole = np.empty((3, smp.spp, smp.dims), np.float32)
+    assert_same_bits(smp.generate(pixels=range(3), out=whole), smp.generate(pixels=range(3)))
+
+
+@pytest.mark.parametrize("bad, exc, words", [
+    (np.empty((2, 5, 2)), TypeError, "float32"),
+    (np.empty((2, 5, 3), np.float32), ValueError, "(2, 5, 2)"),
+    (np.empty((2, 2, 5), np.float32).transpose(0, 2, 1), TypeError, "C-contiguous"),
+    (np.empty((2, 5, 2), np.float32)[::1].view(), None, None),  # a plain view is fine
+    ([[0.0]], TypeError, "numpy.ndarray"),
+])
+def test_out_array_errors(bad, exc, words):
+    smp = pyoa.sampler("bose", spp=49, dims=3, backend="numpy")
+    if exc is None:
+        smp.generate(pixels=[0, 1], samples=range(5), dims=[0, 2], out=bad)
+        return
+    with pytest.raises(exc, match=re.escape(words)):
+        smp.generate(pixels=[0, 1], samples=range(5), dims=[0, 2], out=bad)
+    frozen = np.empty((2, 5, 2), np.float32)
+    frozen.flags.writeable = False
+    with pytest.raises(TypeError, match="writeable"):
+        smp.generate(pixels=[0, 1], samples=range(5), dims=[0, 2], out=frozen)
+
+
 def test_defaults_are_pixel_0_all_samples_all_dims(smp):
     x = smp.generate()
     y = smp.generate(pixels=[0], samples=range(smp.spp), dims=range(smp.dims))

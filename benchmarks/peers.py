@@ -1,0 +1,236 @@
+"""Peer figures for the benchmarks, measured in the same run as pyoa's.
+
+- ``scipy_lhs``: SciPy's orthogonal-array-based Latin hypercube,
+  ``scipy.stats.qmc.LatinHypercube(d, strength=2)``; one ``.random(N)`` call
+  is one pixel's point set. It builds the array in Python loops, so it is
+  timed for a time budget (as many calls as fit) rather than for the whole
+  workload, and the full workload's time is extrapolated.
+- ``mitsuba_sampler``: one of Mitsuba 3's samplers on its LLVM backend,
+  drawing ``dims`` values for ``pixels x spp`` samples in one wavefront, in a
+  subprocess (a Dr.Jit/LLVM abort must not take the benchmark down).
+- ``run_json_script``: the subprocess runner, shared with
+  ``bench_render.py``: runs a Python snippet with this interpreter and reads
+  a JSON object from the last line of its standard output.
+
+Every peer entry has the keys ``name``, ``status`` (``ok``, ``skipped`` or
+``failed``), ``values_per_s`` (None unless ok), ``details`` (a dict) and
+``reason`` (None when ok).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import inspect
+import json
+import signal
+import statistics
+import subprocess
+import sys
+import time
+from typing import Callable
+
+#: Mitsuba 3 samplers timed by ``run_peers``.
+MITSUBA_SAMPLERS = ("orthogonal", "independent", "multijitter", "ldsampler")
+MITSUBA_VARIANT = "llvm_ad_rgb"
+#: Wall-clock limit of one Mitsuba subprocess (import, JIT compilation, warm-up and the timed runs).
+MITSUBA_TIMEOUT_S = 600
+#: ``Sampler.seed``'s ``wavefront_size`` is a uint32 and 2**32 - 1 means "not given".
+MAX_WAVEFRONT = 2**32 - 2
+
+
+def _entry(name: str, status: str, *, values_per_s: float | None = None, details: dict | None = None,
+           reason: str | None = None) -> dict:
+    return {"name": name, "status": status, "values_per_s": values_per_s, "details": details or {},
+            "reason": reason}
+
+
+def module_available(name: str) -> bool:
+    """Whether ``name`` can be imported, without importing it."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def mitsuba_available() -> bool:
+    return module_available("mitsuba")
+
+
+def _failure_line(proc: subprocess.CompletedProcess) -> str:
+    """The exit status and the first line of stderr (of stdout if stderr is empty); for a Python
+    traceback the last line, which names the exception."""
+    code = proc.returncode
+    what = f"exit {code}"
+    if code < 0:
+        try:
+            what += f" ({signal.Signals(-code).name})"
+        except ValueError:
+            pass
+    lines = [ln.strip() for ln in (proc.stderr or proc.stdout or "").splitlines() if ln.strip()]
+    if lines and lines[0].startswith("Traceback"):
+        msg = lines[-1]
+    else:
+        msg = lines[0] if lines else "no output"
+    return f"{what}: {msg}"[:300]
+
+
+def run_json_script(script: str, args: list, *, timeout: float | None = None) -> dict:
+    """Run ``python -c script *args`` in a subprocess and return the JSON object on the last line
+    of its stdout. On a non-zero exit, a timeout or unreadable output, return
+    ``{"status": "failed", "reason": ...}`` instead of raising."""
+    try:
+        proc = subprocess.run([sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True,
+                              timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"status": "failed", "reason": f"timed out after {timeout:g} s"}
+    except OSError as exc:
+        return {"status": "failed", "reason": f"could not start {sys.executable}: {exc}"[:300]}
+    if proc.returncode != 0:
+        return {"status": "failed", "reason": _failure_line(proc)}
+    lines = proc.stdout.strip().splitlines()
+    try:
+        out = json.loads(lines[-1]) if lines else None
+    except json.JSONDecodeError:
+        out = None
+    if not isinstance(out, dict):
+        return {"status": "failed", "reason": f"no JSON result on the last line of stdout: "
+                                              f"{(lines[-1] if lines else '')[:200]!r}"}
+    return out
+
+
+# ---------------------------------------------------------------------------
+# SciPy
+
+
+def scipy_lhs(n: int, d: int, *, budget_s: float, seed: int = 0, max_calls: int | None = None,
+              full_pixels: int | None = None) -> dict:
+    """Time ``LatinHypercube(d, strength=2).random(n)`` for about ``budget_s`` seconds after one warm-up
+    call; ``values_per_s = calls * n * d / elapsed``. One engine serves every call (each call draws a
+    new randomized OA-LHS, as one pixel would). Skipped, with SciPy's message, when strength 2 cannot
+    make ``n`` points in ``d`` dimensions (it needs n = p^2 for a prime p, and d <= p + 1)."""
+    name = "scipy LatinHypercube(strength=2)"
+    try:
+        import scipy
+        from scipy.stats import qmc
+    except ImportError as exc:
+        return _entry(name, "skipped", reason=f"scipy is not installed ({exc})")
+    details = {"scipy": scipy.__version__, "n": n, "d": d, "budget_s": budget_s,
+               "call": f"qmc.LatinHypercube(d={d}, strength=2, rng={seed}).random({n})"}
+    # SciPy 1.15 renamed the keyword seed -> rng; older versions only know seed.
+    key = "rng" if "rng" in inspect.signature(qmc.LatinHypercube).parameters else "seed"
+    try:
+        engine = qmc.LatinHypercube(d=d, strength=2, **{key: seed})
+        t0 = time.perf_counter()
+        x = engine.random(n)
+        details["warmup_s"] = time.perf_counter() - t0
+    except ValueError as exc:  # SciPy's own statement that the configuration is impossible
+        return _entry(name, "skipped", details=details, reason=f"scipy: {exc}")
+    except Exception as exc:  # noqa: BLE001 - reported, never fatal
+        return _entry(name, "failed", details=details, reason=f"{type(exc).__name__}: {exc}"[:300])
+    if x.shape != (n, d):
+        return _entry(name, "failed", details=details, reason=f"random({n}) returned shape {x.shape}")
+    details["dtype"] = str(x.dtype)
+    times: list[float] = []
+    start = time.perf_counter()
+    while True:
+        t0 = time.perf_counter()
+        engine.random(n)
+        t1 = time.perf_counter()
+        times.append(t1 - t0)
+        if t1 - start >= budget_s or (max_calls is not None and len(times) >= max_calls):
+            break
+    elapsed = time.perf_counter() - start
+    calls = len(times)
+    rate = calls * n * d / elapsed
+    details.update(calls=calls, elapsed_s=elapsed, median_call_s=statistics.median(times),
+                   min_call_s=min(times), max_call_s=max(times))
+    if full_pixels:
+        details["full_pixels"] = full_pixels
+        details["full_workload_s"] = full_pixels * elapsed / calls
+    return _entry(name, "ok", values_per_s=rate, details=details)
+
+
+# ---------------------------------------------------------------------------
+# Mitsuba 3
+
+#: argv: variant, sampler name, pixels, spp, dims, repeats, seed, largest wavefront. Prints one JSON line.
+_MITSUBA_SAMPLER = r"""
+import json, statistics, sys, time
+import numpy as np
+import mitsuba as mi
+import drjit as dr
+variant, name = sys.argv[1:3]
+pixels, spp, dims, repeats, seed, max_wavefront = map(int, sys.argv[3:9])
+mi.set_variant(variant)
+sampler = mi.load_dict({"type": name, "sample_count": spp})
+spp_used = int(sampler.sample_count())  # ldsampler rounds up to a power-of-two square
+used_pixels = min(pixels, max_wavefront // spp_used)
+wavefront = used_pixels * spp_used
+# As Mitsuba's own render loop does: all of a pixel's samples in one wavefront, so sample
+# indices 0..spp-1 of one sequence per pixel (without it every lane is sample 0 of its own sequence).
+if hasattr(sampler, "set_samples_per_wavefront"):
+    sampler.set_samples_per_wavefront(spp_used)
+
+def draw():
+    t0 = time.perf_counter()
+    sampler.seed(seed, wavefront)
+    vals = [sampler.next_1d() for _ in range(dims)]
+    dr.eval(*vals)
+    arrs = [np.asarray(v) for v in vals]
+    dt = time.perf_counter() - t0
+    assert all(a.shape == (wavefront,) for a in arrs), [a.shape for a in arrs]
+    return dt
+
+warmup = draw()
+times = [draw() for _ in range(repeats)]
+med = statistics.median(times)
+print(json.dumps({"status": "ok", "version": mi.__version__, "drjit": dr.__version__,
+                  "variant": mi.variant(), "sample_count": spp_used, "pixels": used_pixels,
+                  "wavefront_size": wavefront, "dims": dims, "warmup_s": warmup, "times_s": times,
+                  "median_s": med, "min_s": min(times), "max_s": max(times),
+                  "values_per_s": wavefront * dims / med}))
+"""
+
+
+def mitsuba_sampler(name: str, pixels: int, spp: int, dims: int, *, repeats: int, seed: int = 0,
+                    timeout: float = MITSUBA_TIMEOUT_S, full_pixels: int | None = None) -> dict:
+    """Mitsuba 3 sampler ``name`` (LLVM backend): ``seed(seed, wavefront_size=pixels*spp)`` then
+    ``dims`` times ``next_1d()``, evaluated; one warm-up (JIT compilation), then the median of
+    ``repeats`` runs; ``values_per_s = wavefront * dims / median``. In a subprocess."""
+    label = f"mitsuba {name}"
+    if not mitsuba_available():
+        return _entry(label, "skipped", reason="mitsuba is not installed")
+    argv = [MITSUBA_VARIANT, name, pixels, spp, dims, repeats, seed, MAX_WAVEFRONT]
+    res = run_json_script(_MITSUBA_SAMPLER, argv, timeout=timeout)
+    if res.get("status") != "ok":
+        return _entry(label, "failed", details={"variant": MITSUBA_VARIANT},
+                      reason=res.get("reason") or f"unexpected result: {res!r}"[:300])
+    rate = res.pop("values_per_s")
+    res.pop("status")
+    res["requested_pixels"], res["requested_spp"] = pixels, spp
+    if full_pixels:
+        res["full_pixels"] = full_pixels
+        res["full_workload_s"] = full_pixels * spp * dims / rate  # the requested workload at this rate
+    return _entry(label, "ok", values_per_s=rate, details=res)
+
+
+# ---------------------------------------------------------------------------
+
+
+def run_peers(spp: int, dims: int, *, pixels: int, budget_s: float, repeats: int, seed: int = 0,
+              full_pixels: int | None = None, log: Callable[[str], None] = print) -> list[dict]:
+    """SciPy's OA-LHS, then each Mitsuba sampler, one after the other; never raises."""
+    out = []
+    log(f"peers: scipy LatinHypercube(strength=2), N={spp}, d={dims}, budget {budget_s:g} s")
+    out.append(scipy_lhs(spp, dims, budget_s=budget_s, seed=seed, max_calls=pixels, full_pixels=full_pixels))
+    for name in MITSUBA_SAMPLERS:
+        if mitsuba_available():
+            log(f"peers: mitsuba {name} ({MITSUBA_VARIANT}), {pixels:,} pixels x {spp} spp x {dims} dims, "
+                f"warm-up + {repeats} runs")
+        out.append(mitsuba_sampler(name, pixels, spp, dims, repeats=repeats, seed=seed, full_pixels=full_pixels))
+    for p in out:
+        if p["status"] == "ok":
+            log(f"  {p['name']:<34} {p['values_per_s'] / 1e6:12.3f} M values/s")
+        else:
+            log(f"  {p['name']:<34} {p['status'].upper()}: {p['reason']}")
+    return out
