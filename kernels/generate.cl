@@ -1,31 +1,51 @@
 /* Bulk generation. A request is rows = (pixel, sample) pairs, each of n_dims
- * values, written row-major into out[out0 + (row - row0) * n_dims + d]; a
- * launch covers the rows [row0, row0 + n_values / n_dims). Global sizes are padded to
- * a multiple of the work-group size, hence the bounds checks.
+ * values, written row-major; each launch fills one rectangle of it (see
+ * below) starting at out[out0].
  *
- * Row indices inside a launch are 32-bit and relative to the first pixel of
- * the launch (the host uploads only that launch's pixels): 64-bit divisions
- * made PoCL's cost model refuse to vectorize.
- *
- * Two paths, the same bits:
+ * Two paths for the orthogonal arrays, the same bits:
  * - generate: one work-item per value, everything from scratch (any offset);
- * - tables + generate_cells ('cmj' and 'centered', every construction): the
- *   permutations that do not depend on the sample are computed once per
- *   (pixel, dimension) into a table, then a loop-free kernel that PoCL can
- *   vectorize reads them (POCL-NOTES.md: a cycle-walking loop in a kernel
- *   keeps PoCL scalar). Table entry layout per (pixel, dimension), E entries:
- *   [0, s) stratum permutation, [s, s + M) sub-stratum permutation ('cmj'
- *   only), [E - 1] the jitter seed P3. */
+ * - tables + tables_finish + generate_cells ('cmj' and 'centered', every
+ *   construction): the permutations that do not depend on the sample are
+ *   computed once per (pixel, dimension) into a table, then a loop-free
+ *   kernel that PoCL can vectorize reads them (POCL-NOTES.md: a cycle-walking
+ *   loop in a kernel keeps PoCL scalar). Table entry layout per (pixel,
+ *   dimension), E entries: [0, s) stratum permutation, [s, s + M)
+ *   sub-stratum permutation ('cmj' only), [E - 1] the jitter seed P3.
+ * The comparison samplers have one kernel each (generate_<name>). */
 
-__kernel void generate(__global float *out,
-                       const uint out0,
-                       __global const uint *pixels,
-                       __global const uint *samples,
-                       __global const uint *dims,
-                       const uint n_samples,
-                       const uint n_dims,
-                       const uint row0,
-                       const uint n_values,
+/* Every kernel runs over a rectangle of the request (whole pixels, or a run
+ * of samples of one pixel) as a 2D NDRange: axis 0 is the sample position k
+ * in [0, n_k) (`samples` holds the rectangle's sample indices), axis 1 is
+ * pd = (pixel within the rectangle) * n_dims + d. Everything that depends on
+ * (pixel, dimension) is then uniform along axis 0, where PoCL builds its
+ * work-item loop; no work-item divides a flat index. The host launches
+ * exactly n_k x n_pd work-items (no bounds checks: one makes loads
+ * conditional, and PoCL then neither hoists nor vectorizes). */
+#define RECT_ARGS                                                                       \
+    __global float *restrict out, const uint out0,                                      \
+    __global const uint *restrict pixels, __global const uint *restrict samples,        \
+    __global const uint *restrict dims, const uint n_k, const uint n_dims
+
+/* The index of value (k, pd) in `out`. Its stride along k is n_dims. Written
+ * as k * n_dims, LLVM versions the work-item loop on "n_dims == 1" and runs
+ * the scalar copy for every other n_dims (3x slower, docs/performance.md);
+ * with the top bit set in the multiplier and masked off again it sees no
+ * plain stride. The mask is exact: k * n_dims < 2^31 (a launch writes fewer
+ * values). */
+uint rect_index(uint out0, uint k, uint pl, uint d, uint n_k, uint n_dims)
+{
+    return out0 + pl * n_k * n_dims + ((k * (n_dims | 0x80000000u)) & 0x7fffffffu) + d;
+}
+
+#define RECT_PRELUDE                                                                    \
+    uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                       \
+    uint d = pd % n_dims, pl = pd / n_dims;                                             \
+    uint i = samples[k], j = dims[d];                                                   \
+    uint p = pixel_seed(seed, pixels[pl])
+
+/* The direct path: any offset, everything from scratch (permute's cycle walk
+ * keeps this kernel scalar on PoCL). */
+__kernel void generate(RECT_ARGS,
                        const uint seed,
                        const uint construction,
                        const uint s,
@@ -36,20 +56,15 @@ __kernel void generate(__global float *out,
                        const uint gf_tabled,
                        __global const uint *consts)
 {
-    uint gid = (uint)get_global_id(0);
-    if (gid >= n_values) return;
-    uint row = row0 + gid / n_dims;
-    uint dim = dims[gid % n_dims];
-    uint i = samples[row % n_samples];
-    uint p = pixel_seed(seed, pixels[row / n_samples]);
+    RECT_PRELUDE;
     float x;
-    if (construction == CONSTRUCTION_BOSE)      x = bose(i, dim, s, p, offset, J, gf, gf_tabled);
-    else if (construction == CONSTRUCTION_BUSH) x = bush(i, dim, s, t, p, offset, J, gf, gf_tabled);
+    if (construction == CONSTRUCTION_BOSE)      x = bose(i, j, s, p, offset, J, gf, gf_tabled);
+    else if (construction == CONSTRUCTION_BUSH) x = bush(i, j, s, t, p, offset, J, gf, gf_tabled);
     else if (construction == CONSTRUCTION_ADDELMAN_KEMPTHORNE)
-        x = addelman_kempthorne(i, dim, s, p, offset, J, gf, gf_tabled, consts);
-    else if (construction == CONSTRUCTION_BOSE_BUSH) x = bose_bush(i, dim, s, p, offset, J, gf, gf_tabled);
-    else                                        x = cmjnd(i, dim, s, t, p, offset, J);
-    out[out0 + gid] = x;
+        x = addelman_kempthorne(i, j, s, p, offset, J, gf, gf_tabled, consts);
+    else if (construction == CONSTRUCTION_BOSE_BUSH) x = bose_bush(i, j, s, p, offset, J, gf, gf_tabled);
+    else                                        x = cmjnd(i, j, s, t, p, offset, J);
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = x;
 }
 
 /* The table path, in two launches over a rectangle of pixels x samples
@@ -155,40 +170,22 @@ __kernel void generate_cells(__global float *restrict out,
     uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;
     uint c = d * n_k + k;
     float sub = (offset == OFFSET_CMJ) ? convert_float(tab[base + s + cell_u[c]]) : 0.5f * convert_float(M - 1u);
-    /* The store's stride is n_dims. Written as k * n_dims, LLVM versions the
-     * work-item loop on "n_dims == 1" and runs the scalar copy for every
-     * other n_dims (3x slower, docs/performance.md); with the top bit set in
-     * the multiplier and masked off again it sees no plain stride. The mask
-     * is exact: k * n_dims < 2^31 (a launch writes fewer values). */
-    uint row = (k * (n_dims | 0x80000000u)) & 0x7fffffffu;
-    out[out0 + pl * n_k * n_dims + row + d] = oa_value(isamp[k], tab[base + cell_a[c]], sub, tab[base + E - 1u], M, s, J);
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = oa_value(isamp[k], tab[base + cell_a[c]], sub, tab[base + E - 1u], M, s, J);
 }
 
-/* The comparison samplers: one kernel each, one work-item per value. a and b
- * are the sampler's shape arguments (Baseline.shape_args), `table` its
+/* The comparison samplers: one kernel each, one work-item per value, over a
+ * rectangle like `generate`. a and b are the sampler's shape arguments (Baseline.shape_args), `table` its
  * constants (Halton's primes, Sobol's direction numbers). */
 #define GENERATE_BASELINE(NAME, EXPR)                                                   \
-__kernel void generate_##NAME(__global float *out,                                      \
-                              __global const uint *pixels,                              \
-                              __global const uint *samples,                             \
-                              __global const uint *dims,                                \
-                              const uint n_samples,                                     \
-                              const uint n_dims,                                        \
-                              const uint row0,                                          \
-                              const uint n_values,                                      \
+__kernel void generate_##NAME(RECT_ARGS,                                                \
                               const uint seed,                                          \
                               const uint a,                                             \
                               const uint b,                                             \
                               const float J,                                            \
                               __global const uint *table)                               \
 {                                                                                       \
-    uint gid = (uint)get_global_id(0);                                                  \
-    if (gid >= n_values) return;                                                        \
-    uint row = row0 + gid / n_dims;                                                     \
-    uint j = dims[gid % n_dims];                                                        \
-    uint i = samples[row % n_samples];                                                  \
-    uint p = pixel_seed(seed, pixels[row / n_samples]);                                 \
-    out[gid] = EXPR;                                                                    \
+    RECT_PRELUDE;                                                                       \
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = EXPR;                                \
 }
 
 GENERATE_BASELINE(random, sample_random(i, j, p))

@@ -11,9 +11,9 @@ from ..request import Rect, Request
 from .device import DeviceInfo, select_device
 from .program import build
 
-#: Work-group size. PoCL vectorizes across work-items only when it knows the
-#: group size, and leaving it to PoCL halved throughput (POCL-NOTES.md), so the
-#: global size is padded to a multiple of this and the kernel bounds-checks.
+#: Work-items per group when an axis is split (see OpenCLBackend._launch_2d).
+#: PoCL vectorizes across work-items only when it knows the group size, and
+#: leaving it to PoCL halved throughput (POCL-NOTES.md).
 GROUP_SIZE = 64
 #: Upper bound on one launch's output buffer (OpenCL buffers may not exceed
 #: 2 GiB, and CL_DEVICE_MAX_MEM_ALLOC_SIZE may be smaller still).
@@ -51,7 +51,7 @@ class OpenCLBackend:
         self._axis_limit = min(
             [MAX_AXIS_GROUP]
             + [self._kernels[k].get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.info.device)
-               for k in ("tables", "tables_finish", "generate_cells")]
+               for k in self._kernels]
         )
 
     def describe(self) -> str:
@@ -101,21 +101,30 @@ class OpenCLBackend:
     def _launch_2d(self, name: str, n: int, n_pd: int, *args) -> None:
         """Launch 2D kernel ``name`` over exactly ``n`` x ``n_pd`` work-items.
 
-        The table-path kernels have no bounds check: one would make their
-        loads conditional, and PoCL then neither hoists the per-(pixel,
-        dimension) loads out of its work-item loop nor vectorizes it
-        (docs/performance.md). So the first axis is never padded: one
+        The kernels have no bounds check: one would make their loads
+        conditional, and PoCL then neither hoists the per-(pixel, dimension)
+        loads out of its work-item loop nor vectorizes it
+        (docs/performance.md). So no axis is padded: along the first axis one
         work-group spans it when it fits, else groups of :data:`GROUP_SIZE`
-        cover the largest multiple and a second launch, with a global offset,
-        the rest. Called with self._lock held."""
+        cover the largest multiple and a second launch, at a global offset,
+        the rest; a short first axis takes several rows of the second per
+        group (about GROUP_SIZE work-items a group), with the rows that do
+        not fill a group in a launch of their own. Called with self._lock
+        held."""
         kernel = self._kernels[name]
-        if n <= self._axis_limit:
-            kernel(self.queue, (n, n_pd), (n, 1), *args)
-            return
-        main = n // GROUP_SIZE * GROUP_SIZE
-        kernel(self.queue, (main, n_pd), (GROUP_SIZE, 1), *args)
-        if main < n:
-            kernel(self.queue, (n - main, n_pd), (n - main, 1), *args, global_offset=(main, 0))
+        if n > self._axis_limit:
+            main = n // GROUP_SIZE * GROUP_SIZE
+            parts = [((0, 0), (main, n_pd), (GROUP_SIZE, 1))]
+            if main < n:
+                parts.append(((main, 0), (n - main, n_pd), (n - main, 1)))
+        else:
+            rows = max(1, min(GROUP_SIZE // n, n_pd))
+            main = n_pd // rows * rows
+            parts = [((0, 0), (n, main), (n, rows))]
+            if main < n_pd:
+                parts.append(((0, main), (n, n_pd - main), (n, 1)))
+        for offset, size, local in parts:
+            kernel(self.queue, size, local, *args, global_offset=offset if any(offset) else None)
 
     def rows_per_chunk(self, n_dims: int) -> int:
         return max(1, self.max_chunk_values // max(1, n_dims))
@@ -127,45 +136,33 @@ class OpenCLBackend:
         n_values = (row1 - row0) * req.n_dims
         if n_values == 0:
             return
-        mf = cl.mem_flags
-        ro = mf.READ_ONLY | mf.COPY_HOST_PTR
+        ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         prm = req.params
-        n_s = len(req.samples)
         with self._lock:
-            samples = cl.Buffer(self.context, ro, hostbuf=req.samples)
-            dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
             buf = self._scratch("out", n_values * 4)
+            dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
             if req.construction.family == "baseline":
-                # Only the pixels of these rows travel to the device.
-                pix0, pix1 = row0 // n_s, (row1 - 1) // n_s + 1
-                pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[pix0:pix1]))
                 a, b = (*req.construction.shape_args(prm), 0, 0)[:2]
-                self._kernels[f"generate_{req.construction.function}"](
-                    self.queue, (_padded(n_values),), (GROUP_SIZE,),
-                    buf, pixels, samples, dims,
-                    np.uint32(n_s), np.uint32(req.n_dims), np.uint32(row0 - pix0 * n_s), np.uint32(n_values),
-                    np.uint32(req.seed), np.uint32(a), np.uint32(b), np.float32(req.jitter), self._constants(req),
-                )
-                cl.enqueue_copy(self.queue, out, buf)
-                self.queue.finish()
-                return
-            gf_args = (*self._field(req.construction.field_order(prm)), self._constants(req))
+                kernel = f"generate_{req.construction.function}"
+                extra = (np.uint32(req.seed), np.uint32(a), np.uint32(b), np.float32(req.jitter),
+                         self._constants(req))
+            else:
+                kernel = "generate"
+                extra = (np.uint32(req.seed), np.uint32(req.construction.code),
+                         np.uint32(prm.s), np.uint32(prm.strength),
+                         np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+                         *self._field(req.construction.field_order(prm)), self._constants(req))
             for rect in req.rectangles(row0, row1):
                 # each rectangle's values are a contiguous part of the chunk
-                at = (rect.row0 - row0) * req.n_dims
-                if req.tables_pay_off(rect):
+                at = np.uint32((rect.row0 - row0) * req.n_dims)
+                if req.construction.family != "baseline" and req.tables_pay_off(rect):
                     self._launch_tabled(req, rect, buf, at)
                     continue
+                # only the rectangle's pixels and samples travel to the device
                 pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[rect.pix0 : rect.pix1]))
-                n_rect = (rect.row1 - rect.row0) * req.n_dims
-                self._kernels["generate"](
-                    self.queue, (_padded(n_rect),), (GROUP_SIZE,),
-                    buf, np.uint32(at), pixels, samples, dims,
-                    np.uint32(n_s), np.uint32(req.n_dims), np.uint32(rect.row0 - rect.pix0 * n_s), np.uint32(n_rect),
-                    np.uint32(req.seed), np.uint32(req.construction.code),
-                    np.uint32(prm.s), np.uint32(prm.strength),
-                    np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter), *gf_args,
-                )
+                samples = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1]))
+                self._launch_2d(kernel, rect.n_k, rect.n_pixels * req.n_dims,
+                                buf, at, pixels, samples, dims, np.uint32(rect.n_k), np.uint32(req.n_dims), *extra)
             cl.enqueue_copy(self.queue, out, buf)
             self.queue.finish()
 
@@ -205,8 +202,4 @@ def _field_tables(q: int) -> tuple[np.ndarray, bool]:
     add, mul = gf.tables(q)
     return np.concatenate([add, mul]), True
 
-
-def _padded(n: int) -> int:
-    """``n`` rounded up to a multiple of :data:`GROUP_SIZE`."""
-    return -(-n // GROUP_SIZE) * GROUP_SIZE
 
