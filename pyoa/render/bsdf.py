@@ -266,6 +266,17 @@ def _ggx_sample_vndf(wo: np.ndarray, alpha: np.ndarray, u: np.ndarray) -> np.nda
     return ne
 
 
+def _lanes(m: np.ndarray):
+    """An index for the lanes where ``m`` holds, or None if none: a slice when
+    all do (a scene of one material kind, such as the Cornell box), which
+    makes every ``a[i]`` a view and every ``a[i] = v`` a plain copy instead
+    of a boolean gather or scatter (docs/performance.md)."""
+    if m.all():
+        return slice(None)
+    idx = np.flatnonzero(m)
+    return idx if idx.size else None
+
+
 def _as_inputs(mats: Materials, mat, wo, other):
     mat = np.asarray(mat).reshape(-1)
     wo = np.asarray(wo, dtype=np.float64).reshape(-1, 3)
@@ -322,8 +333,8 @@ def sample(mats: Materials, mat: np.ndarray, wo: np.ndarray, u: np.ndarray):
     delta = kind == MIRROR
     valid = wo[:, 2] > 0.0
 
-    m = (kind == DIFFUSE) & valid
-    if np.any(m):
+    m = _lanes((kind == DIFFUSE) & valid)
+    if m is not None:
         x, y = _concentric_disk(u[m])
         z = np.sqrt(np.maximum(0.0, 1.0 - x * x - y * y))
         d = np.stack([x, y, z], axis=1)
@@ -332,13 +343,13 @@ def sample(mats: Materials, mat: np.ndarray, wo: np.ndarray, u: np.ndarray):
         weight[m] = np.where(above[:, None], color[m], 0.0)
         pdf[m] = np.where(above, wi[m, 2] / np.pi, 0.0)
 
-    m = (kind == MIRROR) & valid
-    if np.any(m):
+    m = _lanes((kind == MIRROR) & valid)
+    if m is not None:
         wi[m] = wo[m] * np.array([-1.0, -1.0, 1.0])
         weight[m] = color[m]
 
-    m = (kind == GGX) & valid
-    if np.any(m):
+    m = _lanes((kind == GGX) & valid)
+    if m is not None:
         wo_m, a_m = wo[m], alpha[m]
         h = _ggx_sample_vndf(wo_m, a_m, u[m])
         d = 2.0 * np.sum(wo_m * h, axis=1)[:, None] * h - wo_m
@@ -383,14 +394,14 @@ def evaluate(mats: Materials, mat: np.ndarray, wo: np.ndarray, wi: np.ndarray):
     pdf = np.zeros(n)
     valid = (wo[:, 2] > 0.0) & (wi[:, 2] > 0.0)
 
-    m = (kind == DIFFUSE) & valid
-    if np.any(m):
+    m = _lanes((kind == DIFFUSE) & valid)
+    if m is not None:
         c = wi[m, 2]
         f_cos[m] = color[m] * (c / np.pi)[:, None]
         pdf[m] = c / np.pi
 
-    m = (kind == GGX) & valid
-    if np.any(m):
+    m = _lanes((kind == GGX) & valid)
+    if m is not None:
         f_cos[m], pdf[m] = _ggx_eval(color[m], alpha[m], wo[m], wi[m])
 
     return f_cos, pdf

@@ -42,6 +42,16 @@ def _rotate(R: np.ndarray, v: np.ndarray) -> np.ndarray:
     return v[:, :1] * R[:, 0] + v[:, 1:2] * R[:, 1] + v[:, 2:3] * R[:, 2]
 
 
+def _compact(keep: np.ndarray, *arrays):
+    """The rows of each array where ``keep`` holds (the arrays themselves when
+    all do): one index computed once, instead of a boolean mask evaluated
+    per array (docs/performance.md)."""
+    if keep.all():
+        return arrays
+    idx = np.flatnonzero(keep)
+    return tuple(a[idx] for a in arrays)
+
+
 @dataclass
 class Stats:
     """Counts of one render (summed over batches)."""
@@ -172,8 +182,8 @@ class Integrator:
             tri, t = self._intersect(o, d)
             stats.rays += len(lane)
             hit = tri >= 0
-            lane, o, d, beta, prev_pdf, prev_delta, tri, t = (
-                a[hit] for a in (lane, o, d, beta, prev_pdf, prev_delta, tri, t))
+            lane, o, d, beta, prev_pdf, prev_delta, tri, t = _compact(
+                hit, lane, o, d, beta, prev_pdf, prev_delta, tri, t)
             if len(lane) == 0:
                 break
             p = o + t[:, None] * d
@@ -203,17 +213,19 @@ class Integrator:
             smooth = sc.materials.kind[mat] != bsdf.MIRROR
             if np.any(smooth):
                 s = np.flatnonzero(smooth)
-                etri, q, nq, pdf_area = self._sample_emitter(row[s][:, L.pair(f"light{depth}")].astype(np.float64))
-                to_q = q - p[s]
+                sel = slice(None) if len(s) == len(smooth) else s  # a view when every lane is smooth
+                etri, q, nq, pdf_area = self._sample_emitter(row[sel][:, L.pair(f"light{depth}")].astype(np.float64))
+                to_q = q - p[sel]
                 dist = np.linalg.norm(to_q, axis=1)
                 wi = to_q / np.maximum(dist, 1e-12)[:, None]
                 cos_q = -dot(nq, wi)
-                f_cos, pdf_b = bsdf.evaluate(sc.materials, mat[s], wo[s], to_local(wi, tb[0][s], tb[1][s], ns[s]))
+                f_cos, pdf_b = bsdf.evaluate(sc.materials, mat[sel], wo[sel],
+                                             to_local(wi, tb[0][sel], tb[1][sel], ns[sel]))
                 pdf_l = pdf_area * dist**2 / np.maximum(cos_q, 1e-12)
                 ok = (cos_q > 0) & np.any(f_cos > 0, axis=1)
                 if np.any(ok):
-                    s, wi, f_cos, pdf_b, pdf_l, etri, q, nq = (
-                        a[ok] for a in (s, wi, f_cos, pdf_b, pdf_l, etri, q, nq))
+                    s, wi, f_cos, pdf_b, pdf_l, etri, q, nq = _compact(
+                        ok, s, wi, f_cos, pdf_b, pdf_l, etri, q, nq)
                     # The shadow ray runs between the two points, each moved off its
                     # surface (towards the other): from p + eps n to q + eps n_q.
                     # Measuring it from p instead let it reach the light's own
@@ -240,6 +252,6 @@ class Integrator:
                 beta = beta / np.where(alive, q, 1.0)[:, None]
             wd = to_world(wi, *tb, ns)
             off = self._eps * np.where((dot(wd, ns) > 0)[:, None], ns, -ns)
-            lane, o, d, beta, prev_pdf, prev_delta = (
-                a[alive] for a in (lane, p + off, wd, beta, pdf, delta))
+            lane, o, d, beta, prev_pdf, prev_delta = _compact(
+                alive, lane, p + off, wd, beta, pdf, delta)
         return radiance, stats
