@@ -239,9 +239,21 @@ def table_keys(req, pix0: int, pix1: int) -> np.ndarray:
     """Per (pixel, dimension) of pixels ``[pix0, pix1)``: the column key ``q``
     and the final shifts ``q * STRATUM_KEY % s`` and ``q * SUBSTRATUM_KEY % M``
     of its two permutations, as a C-contiguous uint32 array of shape
-    ``(pixels, n_dims, 3)`` (the OpenCL ``tables`` kernel reads it)."""
+    ``(pixels, n_dims, 3)`` (the OpenCL ``tables`` kernel reads it).
+
+    Equal to :func:`column_key` per element, but the block seed is hashed
+    once per pixel and distinct block, not per (pixel, dimension): requests
+    have few blocks and many dimensions per block."""
     prm = req.params
-    q = column_key(pixel_seed(req.seed, req.pixels[pix0:pix1])[:, None], req.dims[None, :], prm.block_dims)
-    return np.ascontiguousarray(
-        np.stack([q, q * U32(STRATUM_KEY) % U32(prm.s), q * U32(SUBSTRATUM_KEY) % U32(prm.M)], axis=-1), dtype=U32
-    )
+    dmax = prm.block_dims
+    p = pixel_seed(req.seed, req.pixels[pix0:pix1])
+    out = np.empty((len(p), req.n_dims, 3), dtype=U32)
+    if out.size == 0:
+        return out
+    blocks, which = np.unique(req.dims // U32(dmax), return_inverse=True)
+    seeds = np.stack([block_seed(p, b) for b in blocks], axis=1)  # (pixels, distinct blocks)
+    q = out[..., 0]
+    np.multiply(seeds[:, which], req.dims % U32(dmax) + U32(1), out=q)
+    np.remainder(q * U32(STRATUM_KEY), U32(prm.s), out=out[..., 1])
+    np.remainder(q * U32(SUBSTRATUM_KEY), U32(prm.M), out=out[..., 2])
+    return out

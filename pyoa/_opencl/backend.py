@@ -139,7 +139,14 @@ class OpenCLBackend:
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         prm = req.params
         with self._lock:
-            buf = self._scratch("out", n_values * 4)
+            # A CPU device (PoCL) writes straight into the caller's array
+            # (USE_HOST_PTR): no device buffer, no copy back. A GPU writes into
+            # a reused device buffer that is then copied.
+            zero_copy = self.info.kind == "cpu"
+            if zero_copy:
+                buf = cl.Buffer(self.context, cl.mem_flags.WRITE_ONLY | cl.mem_flags.USE_HOST_PTR, hostbuf=out)
+            else:
+                buf = self._scratch("out", n_values * 4)
             dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
             if req.construction.family == "baseline":
                 a, b = (*req.construction.shape_args(prm), 0, 0)[:2]
@@ -163,7 +170,13 @@ class OpenCLBackend:
                 samples = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1]))
                 self._launch_2d(kernel, rect.n_k, rect.n_pixels * req.n_dims,
                                 buf, at, pixels, samples, dims, np.uint32(rect.n_k), np.uint32(req.n_dims), *extra)
-            cl.enqueue_copy(self.queue, out, buf)
+            if zero_copy:
+                # mapping makes the kernels' writes visible in `out` (where the
+                # runtime could not use the pointer itself, it copies here)
+                mapped, _ = cl.enqueue_map_buffer(self.queue, buf, cl.map_flags.READ, 0, out.shape, out.dtype)
+                mapped.base.release(self.queue)
+            else:
+                cl.enqueue_copy(self.queue, out, buf)
             self.queue.finish()
 
     def _launch_tabled(self, req: Request, rect: Rect, buf, at: int) -> None:
