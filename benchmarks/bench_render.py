@@ -32,6 +32,7 @@ import json
 import os
 import platform
 import statistics
+import time
 import sys
 from pathlib import Path
 
@@ -81,6 +82,50 @@ def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, re
     return peers.run_json_script(_MITSUBA, [width, height, spp, depth, repeats])
 
 
+def profile_parts(scene, args) -> dict:
+    """Where one render's time goes, from a separate single-threaded render of
+    the same image (one thread, so the parts add up to the wall time):
+    ``sampling`` (``Sampler.generate``: the OA values of each batch),
+    ``intersection`` (Embree through embreex: closest hits and shadow rays),
+    ``shading`` (everything else: NumPy camera rays, BSDFs, emitter sampling,
+    MIS, lane bookkeeping). The timers wrap the three methods and cost
+    microseconds per batch; the headline figures come from the timed runs,
+    not from this one."""
+    from pyoa.render.integrator import Integrator
+    from pyoa.samplers import Sampler
+
+    spent = {"sampling": 0.0, "intersection": 0.0}
+    originals = []
+
+    def wrap(cls, name, part):
+        real = getattr(cls, name)
+        originals.append((cls, name, real))
+
+        def timed(*a, **kw):
+            t0 = time.perf_counter()
+            try:
+                return real(*a, **kw)
+            finally:
+                spent[part] += time.perf_counter() - t0
+
+        setattr(cls, name, timed)
+
+    wrap(Sampler, "generate", "sampling")
+    wrap(Integrator, "_intersect", "intersection")
+    wrap(Integrator, "_visible", "intersection")
+    try:
+        w, h = args.size
+        res = render(scene, sampler=args.sampler, spp=args.spp, width=w, height=h, max_depth=args.max_depth,
+                     threads=1)
+    finally:
+        for cls, name, real in originals:
+            setattr(cls, name, real)
+    parts = dict(spent, shading=res.seconds - sum(spent.values()))
+    return {"threads": 1, "seconds": res.seconds, "paths_per_s": res.paths_per_second,
+            "rays_per_s": res.rays_per_second, "parts_s": parts,
+            "shares": {k: v / res.seconds for k, v in parts.items()}}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", default="cornell")
@@ -113,6 +158,7 @@ def main(argv=None) -> int:
         "paths_per_s": mid.stats.paths / med, "rays_per_s": mid.stats.rays / med,
         "rays_per_path": mid.stats.rays / mid.stats.paths,
         "mitsuba": mitsuba_figure(args.scene, w, h, args.spp, args.max_depth, args.repeats),
+        "profile": profile_parts(scene, args),
     }
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -126,11 +172,17 @@ def main(argv=None) -> int:
           f"{report['date_utc']}\n\n| median s | min s | max s | M paths/s | M rays/s | rays/path |\n"
           f"|---:|---:|---:|---:|---:|---:|\n| {med:.2f} | {min(times):.2f} | {max(times):.2f} | "
           f"{report['paths_per_s'] / 1e6:.3f} | {report['rays_per_s'] / 1e6:.3f} | {report['rays_per_path']:.2f} |\n\n"
-          f"{mline}\n")
+          f"{mline}\n\n" + _profile_md(report["profile"]))
     with atomic_path(out.with_suffix(".md")) as tmp:
         tmp.write_text(md)
     print(md)
     return 0
+
+
+def _profile_md(prof: dict) -> str:
+    rows = "".join(f"| {k} | {v:.2f} | {100 * prof['shares'][k]:.0f} % |\n" for k, v in prof["parts_s"].items())
+    return (f"Where the time goes (a separate render on 1 thread: {prof['seconds']:.2f} s, "
+            f"{prof['paths_per_s'] / 1e6:.3f} M paths/s):\n\n| part | s | share |\n|---|---:|---:|\n{rows}")
 
 
 if __name__ == "__main__":
