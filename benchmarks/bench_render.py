@@ -79,7 +79,9 @@ def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, re
         return {"status": "skipped", "reason": "mitsuba is not installed (pip install mitsuba)"}
     if scene != "cornell":
         return {"status": "skipped", "reason": "only the cornell scene has a Mitsuba twin"}
-    return peers.run_json_script(_MITSUBA, [width, height, spp, depth, repeats])
+    res = peers.run_json_script(_MITSUBA, [width, height, spp, depth, repeats], env=peers.mitsuba_env())
+    res["libllvm"] = peers.drjit_llvm()
+    return res
 
 
 def profile_parts(scene, args) -> dict:
@@ -165,7 +167,10 @@ def main(argv=None) -> int:
     with atomic_path(out) as tmp:
         tmp.write_text(json.dumps(report, indent=2) + "\n")
     mit = report["mitsuba"]
-    mline = (f"Mitsuba {mit['version']} `orthogonal`: {mit['paths_per_s'] / 1e6:.3f} M paths/s"
+    mline = (f"Mitsuba {mit['version']} `orthogonal` on its own `cornell_box()` (LLVM backend, "
+             f"{mit.get('libllvm') or 'Dr.Jit default libLLVM'}), same size, depth and spp, median of "
+             f"{len(mit['times_s'])}: {mit['paths_per_s'] / 1e6:.3f} M paths/s; "
+             f"pyoa / Mitsuba = {report['paths_per_s'] / mit['paths_per_s']:.2f}"
              if mit["status"] == "ok" else f"Mitsuba: {mit['status']} ({mit['reason']})")
     md = (f"# pyoa render benchmark\n\n`{args.scene}` {w} x {h}, max depth {args.max_depth}, {args.sampler} "
           f"{args.spp} spp ({mid.dims} dims), {args.repeats} runs after a warm-up, {os.cpu_count()} CPUs, "

@@ -22,6 +22,7 @@ from __future__ import annotations
 import importlib.util
 import inspect
 import json
+import re
 import signal
 import statistics
 import subprocess
@@ -74,20 +75,49 @@ def _failure_line(proc: subprocess.CompletedProcess) -> str:
     return f"{what}: {msg}"[:300]
 
 
-def run_json_script(script: str, args: list, *, timeout: float | None = None) -> dict:
+_ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+
+
+#: Mitsuba 3.9's LLVM backend emits llvm.minimum/maximum, which LLVM before 16
+#: cannot lower on x86 ("LLVM ERROR: Cannot select ... fminimum"); Dr.Jit
+#: loads whichever libLLVM it finds first, here Debian's LLVM 14.
+MIN_DRJIT_LLVM = 16
+
+
+def drjit_llvm() -> str | None:
+    """``$DRJIT_LIBLLVM_PATH`` if set, else the newest system libLLVM >= 16
+    (e.g. Debian's ``libllvm19``), else None (Dr.Jit's own search)."""
+    import glob
+    import os
+
+    if os.environ.get("DRJIT_LIBLLVM_PATH"):
+        return os.environ["DRJIT_LIBLLVM_PATH"]
+    found = []
+    for path in glob.glob("/usr/lib/*/libLLVM.so.*") + glob.glob("/usr/lib/*/libLLVM-*.so") \
+            + glob.glob("/usr/lib/llvm-*/lib/libLLVM.so"):
+        m = re.search(r"LLVM(?:\.so\.|-)(\d+)|llvm-(\d+)/", path)
+        major = int(next(g for g in m.groups() if g)) if m else 0
+        if major >= MIN_DRJIT_LLVM:
+            found.append((major, path))
+    return max(found)[1] if found else None
+
+
+def run_json_script(script: str, args: list, *, timeout: float | None = None, env: dict | None = None) -> dict:
     """Run ``python -c script *args`` in a subprocess and return the JSON object on the last line
     of its stdout. On a non-zero exit, a timeout or unreadable output, return
     ``{"status": "failed", "reason": ...}`` instead of raising."""
     try:
         proc = subprocess.run([sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True,
-                              timeout=timeout)
+                              timeout=timeout, env=env)
     except subprocess.TimeoutExpired:
         return {"status": "failed", "reason": f"timed out after {timeout:g} s"}
     except OSError as exc:
         return {"status": "failed", "reason": f"could not start {sys.executable}: {exc}"[:300]}
     if proc.returncode != 0:
         return {"status": "failed", "reason": _failure_line(proc)}
-    lines = proc.stdout.strip().splitlines()
+    # Mitsuba's logger leaves terminal colour codes (ESC [ ... m) on stdout,
+    # sometimes in front of the JSON line
+    lines = _ANSI.sub("", proc.stdout).strip().splitlines()
     try:
         out = json.loads(lines[-1]) if lines else None
     except json.JSONDecodeError:
@@ -192,6 +222,18 @@ print(json.dumps({"status": "ok", "version": mi.__version__, "drjit": dr.__versi
 """
 
 
+def mitsuba_env() -> dict:
+    """The environment of a Mitsuba subprocess: ours, with DRJIT_LIBLLVM_PATH
+    pointing at an LLVM that can compile Mitsuba's kernels (:func:`drjit_llvm`)."""
+    import os
+
+    env = dict(os.environ)
+    llvm = drjit_llvm()
+    if llvm:
+        env["DRJIT_LIBLLVM_PATH"] = llvm
+    return env
+
+
 def mitsuba_sampler(name: str, pixels: int, spp: int, dims: int, *, repeats: int, seed: int = 0,
                     timeout: float = MITSUBA_TIMEOUT_S, full_pixels: int | None = None) -> dict:
     """Mitsuba 3 sampler ``name`` (LLVM backend): ``seed(seed, wavefront_size=pixels*spp)`` then
@@ -201,12 +243,13 @@ def mitsuba_sampler(name: str, pixels: int, spp: int, dims: int, *, repeats: int
     if not mitsuba_available():
         return _entry(label, "skipped", reason="mitsuba is not installed")
     argv = [MITSUBA_VARIANT, name, pixels, spp, dims, repeats, seed, MAX_WAVEFRONT]
-    res = run_json_script(_MITSUBA_SAMPLER, argv, timeout=timeout)
+    res = run_json_script(_MITSUBA_SAMPLER, argv, timeout=timeout, env=mitsuba_env())
     if res.get("status") != "ok":
-        return _entry(label, "failed", details={"variant": MITSUBA_VARIANT},
+        return _entry(label, "failed", details={"variant": MITSUBA_VARIANT, "libllvm": drjit_llvm()},
                       reason=res.get("reason") or f"unexpected result: {res!r}"[:300])
     rate = res.pop("values_per_s")
     res.pop("status")
+    res["libllvm"] = drjit_llvm()
     res["requested_pixels"], res["requested_spp"] = pixels, spp
     if full_pixels:
         res["full_pixels"] = full_pixels
