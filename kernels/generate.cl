@@ -28,7 +28,7 @@
 
 /* The index of value (k, pd) in `out`. Its stride along k is n_dims. Written
  * as k * n_dims, LLVM versions the work-item loop on "n_dims == 1" and runs
- * the scalar copy for every other n_dims (3x slower, docs/performance.md);
+ * the scalar copy for every other n_dims (2x slower, docs/performance.md);
  * with the top bit set in the multiplier and masked off again it sees no
  * plain stride. The mask is exact: k * n_dims < 2^31 (a launch writes fewer
  * values). */
@@ -72,8 +72,8 @@ __kernel void generate(RECT_ARGS,
  * second axis is pd = (pixel within the launch) * n_dims + d, so that
  * everything derived from (pixel, dimension) is uniform across the first
  * axis: PoCL hoists it out of its work-item loop and vectorizes that loop 8
- * wide (docs/performance.md measured 3x over a 1D range with a division per
- * work-item). The host launches exactly E (or n_k) x n_pd work-items, so
+ * wide (docs/performance.md: 77 -> 173 M values/s over a 1D range with a
+ * division per work-item). The host launches exactly E (or n_k) x n_pd work-items, so
  * neither kernel has a bounds check: one makes the loads conditional, and
  * PoCL then neither hoists the uniform ones nor vectorizes. */
 
@@ -89,12 +89,11 @@ __kernel void generate(RECT_ARGS,
  *
  * permute(i, l, p) = (walk(i) + p % l) % l with walk(i) < l, so the last %
  * is a subtraction. A loop keeps PoCL from vectorizing a kernel, so the walk
- * runs in two launches: `tables` takes TABLE_ROUNDS rounds for every entry
+ * runs in two launches: `tables` takes 3 rounds for every entry
  * (straight-line, 8 lanes wide), which ends the walk of most entries, and
  * stores the others' walk state with WALK_PENDING set; `tables_finish`
  * walks those on to the end (a loop, but over few entries). The jitter-seed
  * slot walks from 0: a walk must start in [0, l), or it may never return. */
-#define TABLE_ROUNDS 3
 #define WALK_PENDING 0x80000000u
 
 __attribute__((always_inline)) uint walk_step(uint x, uint l, uint p, uint w)
@@ -117,8 +116,8 @@ __kernel void tables(__global uint *restrict tab,
     uint l = stratum ? s : M, p = q * (stratum ? STRATUM_KEY : SUBSTRATUM_KEY), c = stratum ? cS : cU;
     uint w = stratum ? wS : wU;
     uint i = stratum ? e : (e + 1u >= E) ? 0u : e - s;
-    /* TABLE_ROUNDS = 3 rounds, written out: a loop, even of constant trip
-     * count, is still there when PoCL builds its work-item loop */
+    /* 3 rounds, written out: a loop, even of constant trip count, is still
+     * there when PoCL builds its work-item loop */
     uint x = walk_step(walk_step(permute_round(i, p, w), l, p, w), l, p, w);
     uint v = x + c;
     v = (x >= l) ? (x | WALK_PENDING) : (v >= l) ? v - l : v;
