@@ -69,8 +69,12 @@ def permute(i, l: int, p) -> np.ndarray:
 
 def randfloat(i, p) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.randfloat`: float32 in ``[0, 1)``."""
-    i, p = np.broadcast_arrays(_u32(i), _u32(p))
-    i = i ^ p
+    # p keeps its own (often much smaller) shape: one seed per (pixel,
+    # dimension) serves every sample, so its terms cost little per value
+    # (at least 1-d: uint32 scalars would warn on the wrapping multiplies)
+    shape = np.broadcast_shapes(np.shape(i), np.shape(p))
+    p = np.atleast_1d(_u32(p))
+    i = np.atleast_1d(_u32(i)) ^ p
     i ^= i >> U32(17)
     i ^= i >> U32(10)
     i *= U32(0xB36534E5)
@@ -82,7 +86,8 @@ def randfloat(i, p) -> np.ndarray:
     i *= U32(1) | (p >> U32(18))
     # uint32 -> float32 rounds to nearest even, then one float32 multiply.
     r = i.astype(np.float32) * _UNIT_SCALE
-    return np.where(p == 0, np.float32(0.5), r)
+    zero = p == 0
+    return (np.where(zero, np.float32(0.5), r) if np.any(zero) else r).reshape(shape)
 
 
 def mix32(x) -> np.ndarray:
