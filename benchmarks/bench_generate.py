@@ -484,22 +484,7 @@ def markdown(report: dict) -> str:
         lines.append(f"- `{case}`: `pyoa.sampler({spec['name']!r}, spp={spec['spp']}, dims={spec['dims']}"
                      f"{st})`; {spec['about']}")
     devices = {r["backend"]: r["device"] for r in report["results"] if r.get("device")}
-    commit = meta["git_commit"] or "unknown"
-    if meta["git_dirty"]:
-        commit += " (with uncommitted changes)"
-    lines += [
-        "",
-        "Machine and software:",
-        "",
-        f"- date (UTC): {meta['date_utc']}; total wall time {report['total_s']:.0f} s",
-        f"- host: {meta['hostname']}; CPU: {meta['cpu_model']}; cores: {meta['cpu_count']} "
-        f"({meta['cpu_count_usable']} usable); load average (1/5/15 min) {_load(meta['loadavg_start'])} "
-        f"before, {_load(meta['loadavg_end'])} after",
-        f"- Python {meta['python']}, NumPy {meta['numpy']}, pyopencl {meta['pyopencl']}, "
-        f"pyoa {meta['pyoa']} (git {commit})",
-    ]
-    for name, dev in devices.items():
-        lines.append(f"- {name} device: {dev}")
+    lines += ["", *machine_lines(meta, report["total_s"], devices)]
     ocl = next((r for r in report["results"] if r.get("opencl_platform_version")), None)
     if ocl:
         lines.append(f"- OpenCL platform version: {ocl['opencl_platform_version']}; "
@@ -507,6 +492,24 @@ def markdown(report: dict) -> str:
     if meta["environment"]:
         lines.append("- environment: " + ", ".join(f"`{k}={v}`" for k, v in meta["environment"].items()))
     return "\n".join(lines) + "\n"
+
+
+def machine_lines(meta: dict, total_s: float, devices: dict) -> list[str]:
+    """The "Machine and software" section of a report (shared by the benchmarks)."""
+    commit = meta["git_commit"] or "unknown"
+    if meta["git_dirty"]:
+        commit += " (with uncommitted changes)"
+    lines = [
+        "Machine and software:",
+        "",
+        f"- date (UTC): {meta['date_utc']}; total wall time {total_s:.0f} s",
+        f"- host: {meta['hostname']}; CPU: {meta['cpu_model']}; cores: {meta['cpu_count']} "
+        f"({meta['cpu_count_usable']} usable); load average (1/5/15 min) {_load(meta['loadavg_start'])} "
+        f"before, {_load(meta['loadavg_end'])} after",
+        f"- Python {meta['python']}, NumPy {meta['numpy']}, pyopencl {meta['pyopencl']}, "
+        f"pyoa {meta['pyoa']} (git {commit})",
+    ]
+    return lines + [f"- {name} device: {dev}" for name, dev in devices.items()]
 
 
 def _write(path: Path, text: str) -> None:

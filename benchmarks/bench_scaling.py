@@ -117,12 +117,12 @@ from bench_generate import (  # noqa: E402  (benchmarks/ is on sys.path above)
     _digest,
     _fail,
     _line,
-    _load,
     _loadavg,
     _log,
     _opencl_details,
     _write,
     machine,
+    machine_lines,
     summarize,
 )
 
@@ -559,23 +559,12 @@ def markdown(report: dict) -> str:
                 lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['paths']:,} | {r['median_s']:.3f} | "
                              f"{r['min_s']:.3f} | {r['max_s']:.3f} | {r['paths_per_s'] / 1e6:.3f} | "
                              f"{r['rays_per_s'] / 1e6:.3f} | {r['rays_per_path']:.2f} |")
-    commit = meta["git_commit"] or "unknown"
-    if meta["git_dirty"]:
-        commit += " (with uncommitted changes)"
     devices = {}
     for rows in report["sweeps"].values():
         for r in rows:
             if r.get("device"):
                 devices.setdefault(r["backend"], r["device"])
-    lines += ["", "Machine and software:", "",
-              f"- date (UTC): {meta['date_utc']}; total wall time {report['total_s']:.0f} s",
-              f"- host: {meta['hostname']}; CPU: {meta['cpu_model']}; cores: {meta['cpu_count']} "
-              f"({meta['cpu_count_usable']} usable); load average (1/5/15 min) {_load(meta['loadavg_start'])} "
-              f"before, {_load(meta['loadavg_end'])} after",
-              f"- Python {meta['python']}, NumPy {meta['numpy']}, pyopencl {meta['pyopencl']}, "
-              f"pyoa {meta['pyoa']} (git {commit})"]
-    for name, dev in devices.items():
-        lines.append(f"- {name} device: {dev}")
+    lines += ["", *machine_lines(meta, report["total_s"], devices)]
     if report.get("figures"):
         lines.append("- figures: " + ", ".join(f"`{p}`" for p in report["figures"]))
     return "\n".join(lines) + "\n"

@@ -57,7 +57,7 @@ class NumpyBackend:
         (:func:`.oa.cells`) once, then one gather per value."""
         prm = req.params
         s, M = prm.s, prm.M
-        q = oa.table_keys(req, rect.pix0, rect.pix1)[..., 0]  # column keys, (pixels, dims)
+        q = oa.column_keys(req, rect.pix0, rect.pix1)  # (pixels, dims)
         aij, u = (c.T for c in oa.cells(req, rect.k0, rect.k1))  # (samples, dims)
         d = np.arange(req.n_dims)
         strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])  # (pixels, dims, s)

@@ -235,25 +235,32 @@ def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
 
 
-def table_keys(req, pix0: int, pix1: int) -> np.ndarray:
-    """Per (pixel, dimension) of pixels ``[pix0, pix1)``: the column key ``q``
-    and the final shifts ``q * STRATUM_KEY % s`` and ``q * SUBSTRATUM_KEY % M``
-    of its two permutations, as a C-contiguous uint32 array of shape
-    ``(pixels, n_dims, 3)`` (the OpenCL ``tables`` kernel reads it).
+def column_keys(req, pix0: int, pix1: int) -> np.ndarray:
+    """:func:`column_key` of every (pixel, dimension) of pixels ``[pix0, pix1)``
+    of request ``req``, shape ``(pixels, n_dims)``.
 
-    Equal to :func:`column_key` per element, but the block seed is hashed
-    once per pixel and distinct block, not per (pixel, dimension): requests
-    have few blocks and many dimensions per block."""
-    prm = req.params
-    dmax = prm.block_dims
+    The block seed is hashed once per pixel and distinct block, not per
+    (pixel, dimension): requests have few blocks and many dimensions per
+    block."""
+    dmax = req.params.block_dims
     p = pixel_seed(req.seed, req.pixels[pix0:pix1])
-    out = np.empty((len(p), req.n_dims, 3), dtype=U32)
-    if out.size == 0:
-        return out
+    if len(p) == 0 or req.n_dims == 0:
+        return np.empty((len(p), req.n_dims), dtype=U32)
     blocks, which = np.unique(req.dims // U32(dmax), return_inverse=True)
     seeds = np.stack([block_seed(p, b) for b in blocks], axis=1)  # (pixels, distinct blocks)
-    q = out[..., 0]
-    np.multiply(seeds[:, which], req.dims % U32(dmax) + U32(1), out=q)
+    return seeds[:, which] * (req.dims % U32(dmax) + U32(1))
+
+
+def table_keys(req, pix0: int, pix1: int) -> np.ndarray:
+    """Per (pixel, dimension) of pixels ``[pix0, pix1)``: the column key ``q``
+    (:func:`column_keys`) and the final shifts ``q * STRATUM_KEY % s`` and
+    ``q * SUBSTRATUM_KEY % M`` of its two permutations, as a C-contiguous
+    uint32 array of shape ``(pixels, n_dims, 3)`` (the OpenCL ``tables``
+    kernel reads it)."""
+    prm = req.params
+    q = column_keys(req, pix0, pix1)
+    out = np.empty((*q.shape, 3), dtype=U32)
+    out[..., 0] = q
     np.remainder(q * U32(STRATUM_KEY), U32(prm.s), out=out[..., 1])
     np.remainder(q * U32(SUBSTRATUM_KEY), U32(prm.M), out=out[..., 2])
     return out

@@ -18,8 +18,8 @@ GROUP_SIZE = 64
 #: Upper bound on one launch's output buffer (OpenCL buffers may not exceed
 #: 2 GiB, and CL_DEVICE_MAX_MEM_ALLOC_SIZE may be smaller still).
 MAX_CHUNK_BYTES = 256 << 20
-#: Longest first axis of a 2D table-path launch that is one work-group (see
-#: OpenCLBackend._axis).
+#: Longest first axis of a 2D launch that is one work-group (see
+#: OpenCLBackend._launch_2d).
 MAX_AXIS_GROUP = 1024
 
 
@@ -48,6 +48,10 @@ class OpenCLBackend:
         self._scratch_bufs: dict[str, object] = {}
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
+        #: A CPU device (PoCL) writes straight into the caller's array
+        #: (USE_HOST_PTR): no device buffer, no copy back. A GPU writes into
+        #: a reused device buffer that is then copied.
+        self.zero_copy = self.info.kind == "cpu"
         self._axis_limit = min(
             [MAX_AXIS_GROUP]
             + [self._kernels[k].get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.info.device)
@@ -139,11 +143,7 @@ class OpenCLBackend:
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         prm = req.params
         with self._lock:
-            # A CPU device (PoCL) writes straight into the caller's array
-            # (USE_HOST_PTR): no device buffer, no copy back. A GPU writes into
-            # a reused device buffer that is then copied.
-            zero_copy = self.info.kind == "cpu"
-            if zero_copy:
+            if self.zero_copy:
                 buf = cl.Buffer(self.context, cl.mem_flags.WRITE_ONLY | cl.mem_flags.USE_HOST_PTR, hostbuf=out)
             else:
                 buf = self._scratch("out", n_values * 4)
@@ -170,7 +170,7 @@ class OpenCLBackend:
                 samples = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1]))
                 self._launch_2d(kernel, rect.n_k, rect.n_pixels * req.n_dims,
                                 buf, at, pixels, samples, dims, np.uint32(rect.n_k), np.uint32(req.n_dims), *extra)
-            if zero_copy:
+            if self.zero_copy:
                 # mapping makes the kernels' writes visible in `out` (where the
                 # runtime could not use the pointer itself, it copies here)
                 mapped, _ = cl.enqueue_map_buffer(self.queue, buf, cl.map_flags.READ, 0, out.shape, out.dtype)
