@@ -30,7 +30,6 @@ import argparse
 import datetime as _dt
 import json
 import os
-import platform
 import statistics
 import time
 import sys
@@ -40,10 +39,8 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py, shared with bench_generate.py
 
-import numpy as np  # noqa: E402
-
 import peers  # noqa: E402
-import pyoa  # noqa: E402
+from bench_generate import _loadavg, machine, machine_lines  # noqa: E402
 from pyoa.atomic import atomic_path  # noqa: E402
 from pyoa.render.render import render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
@@ -140,6 +137,9 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     scene = load(args.scene)
     w, h = args.size
+    t_start = time.perf_counter()
+    meta = machine()
+    meta["loadavg_start"] = _loadavg()
     render(scene, sampler=args.sampler, spp=args.spp, width=16, height=16, max_depth=args.max_depth)
     runs = []
     for k in range(args.repeats):
@@ -152,8 +152,7 @@ def main(argv=None) -> int:
     mid = runs[times.index(med)] if med in times else runs[0]
     report = {
         "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version(),
-                    "numpy": np.__version__, "pyoa": pyoa.__version__},
+        "machine": meta,
         "config": {"scene": args.scene, "sampler": args.sampler, "spp": args.spp, "size": [w, h],
                    "max_depth": args.max_depth, "repeats": args.repeats, "dims": mid.dims},
         "times_s": times, "median_s": med, "min_s": min(times), "max_s": max(times),
@@ -162,6 +161,7 @@ def main(argv=None) -> int:
         "mitsuba": mitsuba_figure(args.scene, w, h, args.spp, args.max_depth, args.repeats),
         "profile": profile_parts(scene, args),
     }
+    meta["loadavg_end"] = _loadavg()
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(out) as tmp:
@@ -177,7 +177,8 @@ def main(argv=None) -> int:
           f"{report['date_utc']}\n\n| median s | min s | max s | M paths/s | M rays/s | rays/path |\n"
           f"|---:|---:|---:|---:|---:|---:|\n| {med:.2f} | {min(times):.2f} | {max(times):.2f} | "
           f"{report['paths_per_s'] / 1e6:.3f} | {report['rays_per_s'] / 1e6:.3f} | {report['rays_per_path']:.2f} |\n\n"
-          f"{mline}\n\n" + _profile_md(report["profile"]))
+          f"{mline}\n\n" + _profile_md(report["profile"])
+          + "\n" + "\n".join(machine_lines(meta, time.perf_counter() - t_start, {})) + "\n")
     with atomic_path(out.with_suffix(".md")) as tmp:
         tmp.write_text(md)
     print(md)

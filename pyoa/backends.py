@@ -4,10 +4,12 @@ Order of choice for :func:`pyoa.sampler`:
 
 1. the ``backend=`` argument (``"opencl"`` or ``"numpy"``);
 2. else the ``PYOA_BACKEND`` environment variable (same names);
-3. else OpenCL if a device builds the kernels (PoCL's CPU device by default;
-   ``device=`` or ``PYOA_OPENCL_DEVICE`` picks another, see
-   :mod:`pyoa._opencl.device`);
-4. else NumPy, with one :class:`PyoaFallbackWarning` saying why.
+3. else OpenCL on the first device that builds the kernels (PoCL's CPU
+   device first; a device whose compiler fails is skipped and the next one
+   tried; ``device=`` or ``PYOA_OPENCL_DEVICE`` picks exactly one, see
+   :mod:`pyoa._opencl.device` and :mod:`pyoa._opencl.choice`);
+4. else NumPy, with one :class:`PyoaFallbackWarning` of at most two lines:
+   which device failed, why in plain words, and what fixes it.
 
 An explicit ``"opencl"`` that cannot be used raises instead of falling back.
 All backends give the same float32 bits for the same request.
@@ -16,6 +18,7 @@ All backends give the same float32 bits for the same request.
 from __future__ import annotations
 
 import os
+import sys
 import threading
 import warnings
 
@@ -30,7 +33,14 @@ class PyoaFallbackWarning(RuntimeWarning):
 
 
 class BackendUnavailable(RuntimeError):
-    """An explicitly requested backend cannot be used here."""
+    """An explicitly requested backend cannot be used here.
+
+    ``cause`` and ``fix`` are one line each (``fix`` may be None).
+    """
+
+    def __init__(self, cause: str, fix: str | None = None):
+        super().__init__(f"{cause}. Fix: {fix}" if fix else cause)
+        self.cause, self.fix = cause, fix
 
 
 _lock = threading.Lock()
@@ -42,14 +52,17 @@ def _opencl_backend(device: str | None):
     """The (cached) OpenCL backend for a device selector; raises BackendUnavailable."""
     from ._opencl.backend import OpenCLBackend
 
+    if device is None:  # the environment's selector, read now: the cache follows it
+        device = os.environ.get("PYOA_OPENCL_DEVICE") or None
     with _lock:
         if device not in _opencl:
             try:
                 _opencl[device] = OpenCLBackend(device)
             except ValueError:
                 raise
-            except Exception as exc:  # ImportError, RuntimeError, pyopencl errors
-                _opencl[device] = BackendUnavailable(str(exc))
+            except Exception as exc:  # NoUsableDevice, ImportError, a driver's own errors
+                cause = getattr(exc, "cause", None) or (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+                _opencl[device] = BackendUnavailable(cause, getattr(exc, "fix", None))
         got = _opencl[device]
     if isinstance(got, BackendUnavailable):
         raise got
@@ -80,39 +93,69 @@ def choose(backend: str | None = None, device: str | None = None):
         with _lock:
             first, _warned = not _warned, True
         if first:
-            warnings.warn(
-                f"pyoa: OpenCL is not usable ({exc}); using the NumPy backend "
-                f"(slower, same bits). Set {ENV_BACKEND}=numpy to silence this.",
-                PyoaFallbackWarning,
-                stacklevel=3,
-            )
+            warnings.warn(fallback_message(exc), PyoaFallbackWarning, stacklevel=_first_frame_outside_pyoa())
         return NumpyBackend()
 
 
+def _first_frame_outside_pyoa() -> int:
+    """The ``stacklevel`` (1 = the caller of this function) of the first frame
+    outside the pyoa package: the warning then names the user's line, whichever
+    of pyoa's entry points (``pyoa.sampler``, ``Sampler``, the renderer) led here."""
+    package = os.path.dirname(os.path.abspath(__file__))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def fallback_message(exc: BackendUnavailable) -> str:
+    """The two lines of the fallback warning: what failed and why, then the fix.
+
+    The whole build log is never in it: ``pyoa backends --verbose`` shows it.
+    """
+    fix = f"Fix: {exc.fix}; or" if exc.fix else "Or"
+    return (f"pyoa: OpenCL is not usable: {exc.cause}; using NumPy instead (same bits, several times slower).\n"
+            f"{fix} set {ENV_BACKEND}=numpy to silence this. Details: pyoa backends --verbose")
+
+
 def backends() -> list[dict]:
-    """Report what is usable here.
+    """Report what is usable here, trying pyoa's program on every OpenCL device.
 
     Returns
     -------
     list of dict
         One dict per backend with keys ``name``, ``usable`` (bool), ``device``
         (what it runs on, or None), ``default`` (bool: what
-        ``backend=None`` picks now) and ``reason`` (why not usable, or None);
-        the OpenCL entry also has ``devices``: every OpenCL device with its
-        selector ``"P:D"``.
+        ``backend=None`` picks now) and ``reason`` (why not usable, or None).
+        The OpenCL entry also has ``fix`` (what to do when not usable, or
+        None) and ``devices``: one dict per OpenCL device, in selector
+        order, with ``selector`` (``"P:D"``), ``description``, ``compiler``
+        (platform, LLVM version and target CPU where known), ``works``
+        (bool), ``used`` (bool: the device OpenCL runs on), ``reason`` and
+        ``fix`` (one line each, None when it works) and ``log`` (the whole
+        build log of a failure, else None).
     """
-    from ._opencl.device import list_devices
+    from ._opencl.choice import probe_all
 
     report = []
     try:
         ocl = _opencl_backend(None)
-        entry = {"name": "opencl", "usable": True, "device": ocl.describe(), "reason": None}
+        entry = {"name": "opencl", "usable": True, "device": ocl.describe(), "reason": None, "fix": None}
+        used = ocl.info.device.int_ptr
     except (BackendUnavailable, ValueError) as exc:
-        entry = {"name": "opencl", "usable": False, "device": None, "reason": str(exc)}
+        entry = {"name": "opencl", "usable": False, "device": None, "fix": getattr(exc, "fix", None),
+                 "reason": getattr(exc, "cause", None) or str(exc)}
+        used = None
     try:
-        entry["devices"] = [f"{d.platform_index}:{d.device_index} {d.describe()}" for d in list_devices()]
-    except RuntimeError:
-        entry["devices"] = []
+        statuses = probe_all()
+    except RuntimeError:  # no platform, or pyopencl missing: the reason above says so
+        statuses = []
+    entry["devices"] = [
+        {"selector": st.info.selector, "description": st.info.describe(), "compiler": st.info.compiler(),
+         "works": st.works, "used": st.info.device.int_ptr == used, "reason": st.reason, "fix": st.fix,
+         "log": st.log}
+        for st in statuses
+    ]
     report.append(entry)
     report.append({"name": "numpy", "usable": True, "device": NumpyBackend().describe(), "reason": None})
     env = (os.environ.get(ENV_BACKEND) or "").strip().lower()

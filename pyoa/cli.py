@@ -13,12 +13,13 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 
 import numpy as np
 
 from . import OFFSETS, backends, sampler, samplers, valid_spp
 from .atomic import atomic_path
-from .backends import BackendUnavailable
+from .backends import BackendUnavailable, PyoaFallbackWarning
 from .constructions import get
 
 FORMATS = (".npy", ".csv")
@@ -131,13 +132,22 @@ def cmd_spectrum(args) -> int:
 
 
 def cmd_backends(args) -> int:
+    from .hostcpu import host_cpu
+
+    print(f"CPU: {host_cpu().describe()}")
     for b in backends():
         mark = "*" if b["default"] else " "
         state = b["device"] if b["usable"] else f"not usable: {b['reason']}"
         print(f"{mark} {b['name']:7s} {state}")
+        if not b["usable"] and b.get("fix"):
+            print(f"          fix: {b['fix']}")
         for d in b.get("devices", []):
-            print(f"      device {d}")
-    print("(* = what backend=None picks; choose with PYOA_BACKEND, PYOA_OPENCL_DEVICE)")
+            verdict = ("works" + (" (used)" if d["used"] else "")) if d["works"] else f"fails: {d['reason']}"
+            print(f"      device {d['selector']} {d['description'].split(' on ')[0]} [{d['compiler']}]: {verdict}")
+            if args.verbose and d["log"]:
+                print("        " + "\n        ".join(d["log"].strip().splitlines()))
+    print("(* = what backend=None picks; choose with PYOA_BACKEND, PYOA_OPENCL_DEVICE; "
+          "--verbose shows the build log of a device that fails)")
     return 0
 
 
@@ -173,7 +183,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--limit", type=int, default=40, help="print at most this many (default 40)")
     p.set_defaults(func=cmd_spp)
 
-    p = sub.add_parser("backends", help="report the usable backends and OpenCL devices")
+    p = sub.add_parser("backends", help="report the usable backends and whether each OpenCL device works")
+    p.add_argument("-v", "--verbose", action="store_true", help="print the whole build log of each device that fails")
     p.set_defaults(func=cmd_backends)
 
     def figure_options(p, out):
@@ -207,11 +218,23 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """pyoa's own fallback warning as its two plain lines (no file name or
+    source line: on the command line they point into pyoa, not at the user)."""
+    if issubclass(category, PyoaFallbackWarning):
+        print(message, file=sys.stderr if file is None else file)
+    else:
+        print(warnings.formatwarning(message, category, filename, lineno, line), end="",
+              file=sys.stderr if file is None else file)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
     args = ap.parse_args(argv)
     try:
-        return args.func(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return args.func(args)
     except (ValueError, TypeError, FileNotFoundError, BackendUnavailable) as exc:
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
 

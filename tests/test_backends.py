@@ -64,8 +64,16 @@ def test_backends_report_follows_environment(monkeypatch):
 def test_backends_report_with_opencl(monkeypatch):
     monkeypatch.delenv("PYOA_BACKEND", raising=False)
     ocl = pyoa.backends()[0]
-    assert ocl["usable"] and ocl["default"] and ocl["devices"]
-    assert all(isinstance(d, str) and ":" in d for d in ocl["devices"])
+    assert ocl["usable"] and ocl["default"] and ocl["devices"] and ocl["fix"] is None
+    for d in ocl["devices"]:
+        assert {"selector", "description", "compiler", "works", "used", "reason", "fix", "log"} <= set(d)
+        assert d["selector"].count(":") == 1 and d["description"] and d["compiler"]
+        assert (d["reason"] is None) == d["works"] == (d["log"] is None) == (d["fix"] is None)
+        if not d["works"]:
+            assert "\n" not in d["reason"] and "\n" not in d["fix"]
+    used = [d for d in ocl["devices"] if d["used"]]
+    assert len(used) == 1 and used[0]["works"]
+    assert used[0]["description"] == ocl["device"]
 
 
 def test_fallback_warns_once_and_uses_numpy(no_opencl):
@@ -156,7 +164,8 @@ SCRIPT = textwrap.dedent("""
 
 
 def _run(tmp_path, env_extra, extra_path=None):
-    env = {k: v for k, v in os.environ.items() if not k.startswith("PYOA_")}
+    # pyoa's own settings are dropped, but the device under test is kept
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYOA_") or k == "PYOA_OPENCL_DEVICE"}
     env.update(env_extra)
     if extra_path:
         env["PYTHONPATH"] = os.pathsep.join([str(extra_path)] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))

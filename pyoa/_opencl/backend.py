@@ -8,8 +8,8 @@ import numpy as np
 
 from .. import constructions, gf
 from ..request import Rect, Request
-from .device import DeviceInfo, select_device
-from .program import build
+from .choice import open_device
+from .device import DeviceInfo
 
 #: Work-items per group when an axis is split (see OpenCLBackend._launch_2d).
 #: PoCL vectorizes across work-items only when it knows the group size, and
@@ -26,6 +26,10 @@ MAX_AXIS_GROUP = 1024
 class OpenCLBackend:
     """One OpenCL device with pyoa's program built on it.
 
+    ``selector`` names the device (see :mod:`pyoa._opencl.device`); without
+    one, the first candidate device that builds the program is used
+    (:func:`pyoa._opencl.choice.open_device`).
+
     A lock serializes launches, so one backend (and every Sampler using it)
     is safe to call from several threads.
     """
@@ -37,8 +41,8 @@ class OpenCLBackend:
     def __init__(self, selector: str | None = None):
         import pyopencl as cl
 
-        self.info: DeviceInfo = select_device(selector)
-        self.context, self.queue, self.program = build(self.info)
+        self.info: DeviceInfo
+        self.info, (self.context, self.queue, self.program) = open_device(selector)
         self._lock = threading.Lock()
         # Kernel objects are fetched once (each retrieval builds a new one);
         # their arguments are set under self._lock.

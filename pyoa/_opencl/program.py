@@ -10,6 +10,11 @@ so later processes build fast.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import re
+import sys
+import tempfile
 import threading
 from importlib import resources
 
@@ -19,7 +24,7 @@ from .device import DeviceInfo
 BUILD_OPTIONS = ["-cl-fp32-correctly-rounded-divide-sqrt"]
 
 _lock = threading.Lock()
-_cache: dict[int, tuple] = {}
+_cache: dict[tuple, tuple] = {}
 
 
 def defines() -> list[str]:
@@ -41,25 +46,82 @@ def source() -> str:
     )
 
 
-def build(info: DeviceInfo):
+class BuildError(RuntimeError):
+    """pyoa's program cannot be used on a device.
+
+    ``stage`` is ``"context"`` (the device could not be opened) or ``"build"``
+    (its compiler rejected the program); ``log`` is the whole message of the
+    OpenCL error, build log and options included, for ``pyoa backends
+    --verbose``; ``str()`` is one line.
+    """
+
+    def __init__(self, info: DeviceInfo, stage: str, log: str):
+        self.info, self.stage, self.log = info, stage, log
+        first = first_error(log)
+        super().__init__(f"OpenCL {stage} failed on {info.short()}: {first[:200]}")
+
+
+def first_error(log: str) -> str:
+    """The first compiler diagnostic of a build log without its source
+    location (``error: expected ')'``), else the log's first line."""
+    lines = [ln.strip() for ln in log.splitlines() if ln.strip()]
+    for ln in lines:
+        m = re.search(r"\berror\s*:\s*(?:[^\s:]+:\d+(?::\d+)?(?:\s*<.*>)?\s*:\s*)?(.*)", ln, re.IGNORECASE)
+        if m:
+            return f"error: {m[1]}"
+    return lines[0] if lines else ""
+
+
+@contextlib.contextmanager
+def _stderr_to(path):
+    """Send file descriptor 2 to ``path`` for the duration: PoCL's compiler
+    prints its diagnostics straight to the process's stderr, and a failed
+    build must not flood every user with them (they go into the build log)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(path, "wb") as fh:
+            os.dup2(fh.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def build(info: DeviceInfo, *, text: str | None = None):
     """Return ``(context, queue, program)`` for a device, building it on first use.
+
+    ``text`` replaces the program text (default: :func:`source`); the build
+    options are always pyoa's. Successful builds are cached per (device,
+    text); failed ones are not (the caller remembers why).
 
     Raises
     ------
-    RuntimeError
+    BuildError
         If the device cannot create a context or the program does not build
-        (the message carries the build log).
+        (it carries the build log).
     """
     import pyopencl as cl
 
-    key = info.device.int_ptr
+    key = (info.device.int_ptr, text)
     with _lock:
         if key not in _cache:
+            stage = "context"
             try:
                 ctx = cl.Context([info.device])
                 queue = cl.CommandQueue(ctx)
-                prg = cl.Program(ctx, source()).build(options=BUILD_OPTIONS + defines())
+                stage = "build"
+                with tempfile.TemporaryDirectory(prefix="pyoa-build-") as tmp:
+                    printed = os.path.join(tmp, "stderr")
+                    try:
+                        with _stderr_to(printed):
+                            prg = cl.Program(ctx, source() if text is None else text).build(
+                                options=BUILD_OPTIONS + defines())
+                    finally:
+                        with open(printed, "rb") as fh:
+                            noise = fh.read().decode(errors="replace")
             except cl.Error as exc:
-                raise RuntimeError(f"OpenCL build failed on {info.describe()}: {exc}") from exc
+                log = str(exc) + (f"\n(the compiler also printed)\n{noise}" if stage == "build" and noise.strip() else "")
+                raise BuildError(info, stage, log) from exc
             _cache[key] = (ctx, queue, prg)
         return _cache[key]
