@@ -92,15 +92,25 @@ def _device_id(prefix: str, selector) -> str:
     return prefix if selector is None else f"{prefix}-{selector.replace(':', '.')}"
 
 
-def pytest_report_header(config):
-    if not os.environ.get(TEST_DEVICES_ENV, "").strip():
-        return None
+def _devices_report():
     lines = [f"OpenCL devices under test ({TEST_DEVICES_ENV}={os.environ[TEST_DEVICES_ENV]}): "
              + ", ".join(s or "default" for s in test_devices())]
     for st in device_statuses():
         verdict = "works" if st.works else f"fails: {st.reason}"
         lines.append(f"  {st.info.selector} {st.info.device.name.strip()} [{st.info.compiler()}]: {verdict}")
     return lines
+
+
+def pytest_collection_finish(session):
+    """With PYOA_TEST_DEVICES set, say which devices the OpenCL tests run on
+    and why any other fails (written even under -q, unlike a report header)."""
+    if not os.environ.get(TEST_DEVICES_ENV, "").strip():
+        return
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:
+        reporter.write_line("")
+        for line in _devices_report():
+            reporter.write_line(line)
 
 
 def pytest_generate_tests(metafunc):

@@ -46,8 +46,14 @@ def breaking_first(n_broken: int = 1):
     return build
 
 
+def working_candidates():
+    """The candidates that build pyoa's own program here, in candidate order
+    (on AMD Zen 5, pip's PoCL 3.0 is listed but never builds)."""
+    return [info for info in candidates() if choice.probe(info).works]
+
+
 def test_failing_device_is_skipped_and_its_reason_kept():
-    first = candidates()[0]
+    first = working_candidates()[0]
     # The same device twice: its first build fails for real, the second
     # candidate (the device again, now with pyoa's own program) is used.
     build = breaking_first()
@@ -57,15 +63,16 @@ def test_failing_device_is_skipped_and_its_reason_kept():
 
 
 def test_next_distinct_device_is_used_when_the_first_fails():
-    devices = candidates()
+    devices = working_candidates()
     if len(devices) < 2:
-        pytest.skip("one OpenCL device here: the skip to a second device needs two (CI installs a second PoCL)")
+        pytest.skip("one working OpenCL device here: the skip to a second one needs two (CI installs a second "
+                    "PoCL; both work on the AVX2 and Zen 4 EPYC)")
     info, _ = choice.first_working(devices, build=breaking_first())
     assert info.device.int_ptr == devices[1].device.int_ptr
 
 
 def test_no_device_builds_names_the_first_and_counts_the_rest():
-    devices = candidates()
+    devices = working_candidates()
     with pytest.raises(NoUsableDevice) as exc:
         choice.first_working(devices + devices, build=breaking_first(n_broken=10**6))
     err = exc.value
@@ -77,7 +84,7 @@ def test_no_device_builds_names_the_first_and_counts_the_rest():
 
 
 def test_explicit_selector_is_never_swapped(monkeypatch):
-    first = list_devices()[0]
+    first = working_candidates()[-1]
     build = breaking_first()
     with pytest.raises(NoUsableDevice) as exc:
         choice.open_device(first.selector, build=build)
@@ -189,11 +196,12 @@ def test_subprocess_falls_back_with_a_two_line_warning(only_pip_pocl_broken):
     lines = msg.splitlines()
     assert len(lines) == 2, msg
     assert "pthread" in lines[0] and "PoCL 3.0" in lines[0] and "cannot build pyoa's kernels" in lines[0]
-    assert "its compiler stops with error:" in lines[0]
+    # the broken macro, or (on a CPU newer than LLVM 14, e.g. AMD Zen 5) the real cause
+    assert "its compiler stops with error:" in lines[0] or "LLVM 14 does not know this CPU" in lines[0]
     assert "PYOA_BACKEND=numpy" in lines[1] and "pyoa backends --verbose" in lines[1]
     assert "clBuildProgram" not in msg and "-DOFFSET" not in msg
     # PoCL's own compiler output went into the build log, not to the user's terminal
-    assert "error" not in res.stderr.lower(), res.stderr
+    assert "errors generated" not in res.stderr and "expected identifier" not in res.stderr, res.stderr
 
 
 def test_cli_backends_names_the_failing_device_in_one_line(only_pip_pocl_broken):
@@ -203,13 +211,16 @@ def test_cli_backends_names_the_failing_device_in_one_line(only_pip_pocl_broken)
     assert res.returncode == 0, res.stderr
     lines = res.stdout.splitlines()
     dev = [ln for ln in lines if ln.strip().startswith("device 0:0")]
-    assert len(dev) == 1 and "PoCL 3.0" in dev[0] and ": fails: its compiler stops with error:" in dev[0], res.stdout
+    assert len(dev) == 1 and "PoCL 3.0" in dev[0] and ": fails: " in dev[0], res.stdout
+    assert "its compiler stops with error:" in dev[0] or "LLVM 14 does not know this CPU" in dev[0]
     assert any(ln.startswith("  opencl  not usable:") for ln in lines)
     assert any(ln.startswith("* numpy") for ln in lines)
     assert lines[0].startswith("CPU: ") and "clBuildProgram" not in res.stdout
     verbose = subprocess.run(cmd + ["backends", "--verbose"], capture_output=True, text=True,
                              env=only_pip_pocl_broken, timeout=300)
-    assert "clBuildProgram failed" in verbose.stdout and "errors generated" in verbose.stdout
+    assert "clBuildProgram failed" in verbose.stdout
+    if "its compiler stops with error:" in dev[0]:  # what the compiler printed is in the log
+        assert "errors generated" in verbose.stdout
     # the CLI prints the fallback warning as its two plain lines
     points = subprocess.run(cmd + ["points", "--spp", "9", "--dims", "2", "--out", str(Path(only_pip_pocl_broken[
         "POCL_CACHE_DIR"]).parent / "p.npy"), "-q"], capture_output=True, text=True, env=only_pip_pocl_broken,
