@@ -14,7 +14,7 @@ from .. import constructions
 from ..atomic import atomic_path
 from ..cli import _rate
 from .image import read_image, rel_mse, write_exr, write_png
-from .render import render
+from .render import SHADINGS, render
 from .scene import load
 
 
@@ -37,7 +37,7 @@ def cmd_render(args) -> int:
     res = render(scene, sampler=args.sampler, spp=args.spp, seed=args.seed,
                  **_size(args),
                  max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                 progress=not args.quiet)
+                 shading=args.shading, progress=not args.quiet)
     write_exr(args.out, res.image)
     if args.png:
         write_png(args.png, res.image)
@@ -68,7 +68,7 @@ def cmd_compare(args) -> int:
         res = render(scene, sampler=name, spp=spp, seed=args.seed,
                      **_size(args),
                      max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                     progress=not args.quiet)
+                     shading=args.shading, progress=not args.quiet)
         if ref is None:
             ref = _reference(args.reference, res.image.shape)
         crop = args.crop or _default_crop(res.image.shape)
@@ -169,7 +169,7 @@ def cmd_reference(args) -> int:
     for k in tqdm(range(done, passes), initial=done, total=passes, desc="reference passes", disable=args.quiet):
         res = render(scene, sampler=args.sampler, spp=args.pass_spp, seed=pass_seed(args.seed, k),
                      **_size(args),
-                     max_depth=args.max_depth, filter=args.filter, backend=args.backend)
+                     max_depth=args.max_depth, filter=args.filter, backend=args.backend, shading=args.shading)
         img = res.image.astype(np.float64)
         total = img if total is None else total + img
         with atomic_path(state) as tmp:
@@ -197,6 +197,9 @@ def add_parsers(sub) -> None:
         p.add_argument("--first", type=lambda s: [t for t in s.split(",") if t], default=None,
                        help="integrand dimensions to put in the first sampler dimensions, e.g. light1,lens")
         p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="sampler backend")
+        p.add_argument("--shading", choices=SHADINGS, default=None,
+                       help="numba: compiled shading calling Embree (default); numpy: the NumPy reference "
+                            "(default: $PYOA_SHADING, else numba)")
         p.add_argument("-q", "--quiet", action="store_true", help="print nothing but results")
 
     p = sub.add_parser("render", help="render a scene with one sampler (EXR, optional PNG)")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
@@ -22,6 +23,23 @@ from .layout import Layout
 
 #: Camera paths per batch (bounds the working set: ~1 KiB per path).
 BATCH_PATHS = 1 << 16
+#: Shading implementations: numba-compiled with Embree called from it (the
+#: default), or the NumPy reference.
+SHADINGS = ("numba", "numpy")
+ENV_SHADING = "PYOA_SHADING"
+
+
+def resolve_shading(shading: str | None) -> str:
+    """The shading to use: ``shading``, else ``$PYOA_SHADING``, else ``"numba"``."""
+    origin = "shading"
+    if shading is None:
+        shading, origin = os.environ.get(ENV_SHADING) or "numba", f"${ENV_SHADING}"
+    if not isinstance(shading, str):
+        raise TypeError(f"shading must be a str or None, got {type(shading).__name__}")
+    name = shading.strip().lower()
+    if name not in SHADINGS:
+        raise ValueError(f"unknown {origin} {shading!r}; valid: {', '.join(SHADINGS)}")
+    return name
 
 
 @dataclass
@@ -36,6 +54,9 @@ class RenderResult:
     layout: str
     seconds: float
     stats: Stats = field(default_factory=Stats)
+    shading: str = "numba"
+    #: seconds per stage summed over the worker threads (compiled shading only)
+    timings: dict = field(default_factory=dict)
 
     @property
     def paths_per_second(self) -> float:
@@ -46,10 +67,27 @@ class RenderResult:
         return self.stats.rays / max(self.seconds, 1e-9)
 
 
+class ShadingFallbackWarning(RuntimeWarning):
+    """The compiled shading was not usable and the NumPy reference rendered instead."""
+
+
+_warned = False
+
+
+def _warn_fallback(exc: BaseException) -> None:
+    global _warned
+    if not _warned:
+        _warned = True
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        warnings.warn(f"pyoa: compiled shading is not usable ({type(exc).__name__}: {first}); rendering with the "
+                      f"NumPy reference shading instead (same estimate, slower). Set {ENV_SHADING}=numpy to "
+                      "silence this.", ShadingFallbackWarning, stacklevel=3)
+
+
 def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
            height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
            backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
-           progress: bool = False) -> RenderResult:
+           progress: bool = False, shading: str | None = None) -> RenderResult:
     """Render ``scene`` (a :class:`pyoa.render.scene.Scene`) with ``spp`` samples per pixel.
 
     Parameters
@@ -74,7 +112,15 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         Worker threads (default: the number of CPUs).
     progress : bool
         Show a tqdm progress bar.
+    shading : {"numba", "numpy"}, optional
+        ``"numba"`` (default): shading compiled with numba, Embree called from
+        it (:mod:`pyoa.render.compiled`); ``"numpy"``: the NumPy reference
+        (:mod:`pyoa.render.integrator`). Default ``$PYOA_SHADING``, else numba.
+        Both estimate the same image; each gives the same bits for any batch
+        size and thread count.
     """
+    explicit = shading is not None
+    shading = resolve_shading(shading)
     width = int(width or scene.width)
     height = int(height or scene.height)
     if width < 1 or height < 1:
@@ -84,7 +130,19 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     layout = Layout(max_depth=depth, mis=scene.mis, lens=cam.aperture > 0,
                     time=bool(np.any(np.asarray(cam.motion) != 0)), first=first)
     smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend)
-    integ = Integrator(scene, layout, width, height, filter=filter)
+    integ = None
+    if shading == "numba":
+        try:
+            from .compiled.integrator import CompiledIntegrator
+
+            integ = CompiledIntegrator(scene, layout, width, height, filter=filter)
+        except (ImportError, OSError, RuntimeError) as exc:  # numba missing, Embree library unusable
+            if explicit:
+                raise RuntimeError(f"compiled shading is not usable here: {exc}") from exc
+            _warn_fallback(exc)
+            shading = "numpy"
+    if integ is None:
+        integ = Integrator(scene, layout, width, height, filter=filter)
     n_pixels = width * height
     per_batch = max(1, batch_paths // spp)
     batches = [(p0, min(p0 + per_batch, n_pixels)) for p0 in range(0, n_pixels, per_batch)]
@@ -120,4 +178,5 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
             bar.close()
     seconds = time.perf_counter() - t0
     return RenderResult(image=out.reshape(height, width, 3), sampler=smp.name, spp=spp, seed=seed,
-                        dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total)
+                        dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total, shading=shading,
+                        timings=dict(getattr(integ, "timings", {})))

@@ -11,7 +11,9 @@ and a correct renderer lands within a few of them. The scenes are tiny
 deterministic.
 
 Scenes are written as JSON (the format of :mod:`pyoa.render.scene`) into
-``tmp_path`` and loaded like any scene file.
+``tmp_path`` and loaded like any scene file. Every test runs on both shading
+implementations: the numba-compiled one with Embree called from it (the
+default) and the NumPy reference (``PYOA_SHADING``).
 """
 
 from __future__ import annotations
@@ -33,6 +35,13 @@ Z = 5.0
 #: stratified sampler on a smooth integrand, must not fail on float32 rounding
 #: or the sub-pixel variation of the integrand over a narrow field of view).
 REL_FLOOR = 2e-3
+
+
+@pytest.fixture(autouse=True, params=["numba", "numpy"])
+def shading(request, monkeypatch):
+    """The shading implementation under test (through ``PYOA_SHADING``, as a user picks it)."""
+    monkeypatch.setenv("PYOA_SHADING", request.param)
+    return request.param
 
 
 # -- helpers -----------------------------------------------------------------------
@@ -426,9 +435,10 @@ def cornell():
     return load("cornell")
 
 
-def test_same_render_same_bits(cornell):
+def test_same_render_same_bits(cornell, shading):
     kw = dict(sampler="bose", spp=4, seed=3, width=16, height=12)
     a = render(cornell, **kw)
+    assert a.shading == shading
     b = render(cornell, **kw)
     assert a.image.shape == (12, 16, 3) and a.image.dtype == np.float32
     assert a.image.tobytes() == b.image.tobytes()

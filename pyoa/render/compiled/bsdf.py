@@ -1,0 +1,126 @@
+"""The BSDFs of :mod:`pyoa.render.bsdf`, one shading point at a time, compiled.
+
+Same models, same formulas and the same guards as the NumPy reference
+(Lambertian with Malley's method, mirror, GGX conductor with visible-normal
+sampling and the height-correlated Smith term in its tan-free form): read the
+reference's docstring for the math. Functions are named after the
+reference's (``ggx_d`` mirrors ``bsdf._ggx_d``, ...). Vectors are passed as
+three floats, directions are unit vectors in the local shading frame
+(normal = +z) with ``wo.z > 0``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ..bsdf import ALPHA_MIN, DIFFUSE, GGX, MIRROR
+from .geometry import concentric_disk
+
+_TINY = 1e-300
+_JIT = dict(nogil=True, cache=True, inline="always")
+
+
+@njit(**_JIT)
+def ggx_lambda_root(x, y, z, alpha):
+    """:math:`a(\\omega) = \\sqrt{\\omega_z^2 + \\alpha^2(\\omega_x^2 + \\omega_y^2)}`."""
+    return math.sqrt(z * z + alpha * alpha * (x * x + y * y))
+
+
+@njit(**_JIT)
+def ggx_d(hx, hy, hz, alpha):
+    """GGX normal distribution :math:`D(h)`, cancellation-free form."""
+    t = (hx * hx + hy * hy) / (alpha * alpha) + hz * hz
+    return 1.0 / max(math.pi * alpha * alpha * t * t, _TINY)
+
+
+@njit(**_JIT)
+def ggx_eval(cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz):
+    """GGX ``(f_cos r, g, b, pdf)`` for ``wo.z > 0`` and ``wi.z > 0``."""
+    hx, hy, hz = ox + ix, oy + iy, oz + iz
+    hn = max(math.sqrt(hx * hx + hy * hy + hz * hz), _TINY)
+    hx, hy, hz = hx / hn, hy / hn, hz / hn
+    d = ggx_d(hx, hy, hz, alpha)
+    ao = ggx_lambda_root(ox, oy, oz, alpha)
+    ai = ggx_lambda_root(ix, iy, iz, alpha)
+    cos_oh = min(max(ox * hx + oy * hy + oz * hz, 0.0), 1.0)
+    s5 = (1.0 - cos_oh) ** 5
+    g = d * iz / max(2.0 * (ao * iz + ai * oz), _TINY)
+    pdf = d / max(2.0 * (oz + ao), _TINY)
+    return (cr + (1.0 - cr) * s5) * g, (cg + (1.0 - cg) * s5) * g, (cb + (1.0 - cb) * s5) * g, pdf
+
+
+@njit(**_JIT)
+def ggx_sample_vndf(ox, oy, oz, alpha, u0, u1):
+    """A visible microfacet normal (Heitz 2018, listing 1)."""
+    vx, vy, vz = alpha * ox, alpha * oy, oz
+    vn = max(math.sqrt(vx * vx + vy * vy + vz * vz), _TINY)
+    vx, vy, vz = vx / vn, vy / vn, vz / vn
+    lensq = vx * vx + vy * vy
+    if lensq > 0.0:
+        inv = 1.0 / math.sqrt(lensq)
+        t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
+    else:
+        t1x, t1y, t1z = 1.0, 0.0, 0.0
+    # t2 = vh x t1
+    t2x = vy * t1z - vz * t1y
+    t2y = vz * t1x - vx * t1z
+    t2z = vx * t1y - vy * t1x
+    r = math.sqrt(u0)
+    phi = 2.0 * math.pi * u1
+    p1 = r * math.cos(phi)
+    p2 = r * math.sin(phi)
+    s = 0.5 * (1.0 + vz)
+    p2 = (1.0 - s) * math.sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2
+    p3 = math.sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2))
+    nx = p1 * t1x + p2 * t2x + p3 * vx
+    ny = p1 * t1y + p2 * t2y + p3 * vy
+    nz = p1 * t1z + p2 * t2z + p3 * vz
+    ex, ey, ez = alpha * nx, alpha * ny, max(0.0, nz)
+    norm = math.sqrt(ex * ex + ey * ey + ez * ez)
+    if norm > _TINY:
+        return ex / norm, ey / norm, ez / norm
+    return 0.0, 0.0, 1.0
+
+
+@njit(**_JIT)
+def sample(kind, cr, cg, cb, alpha, ox, oy, oz, u0, u1):
+    """``(wi x, y, z, weight r, g, b, pdf, delta)``: :func:`pyoa.render.bsdf.sample` for one point."""
+    if oz <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, kind == MIRROR
+    if kind == DIFFUSE:
+        x, y = concentric_disk(u0, u1)
+        z = math.sqrt(max(0.0, 1.0 - x * x - y * y))
+        n = math.sqrt(x * x + y * y + z * z)
+        x, y, z = x / n, y / n, z / n
+        if z > 0.0:
+            return x, y, z, cr, cg, cb, z / math.pi, False
+        return x, y, z, 0.0, 0.0, 0.0, 0.0, False
+    if kind == MIRROR:
+        return -ox, -oy, oz, cr, cg, cb, 0.0, True
+    # GGX
+    a = max(alpha, ALPHA_MIN)
+    hx, hy, hz = ggx_sample_vndf(ox, oy, oz, a, u0, u1)
+    c = 2.0 * (ox * hx + oy * hy + oz * hz)
+    dx, dy, dz = c * hx - ox, c * hy - oy, c * hz - oz
+    dn = max(math.sqrt(dx * dx + dy * dy + dz * dz), _TINY)
+    dx, dy, dz = dx / dn, dy / dn, dz / dn
+    if dz > 0.0:
+        fr, fg, fb, p = ggx_eval(cr, cg, cb, a, ox, oy, oz, dx, dy, dz)
+        if p > 0.0 and math.isfinite(p):
+            return dx, dy, dz, fr / p, fg / p, fb / p, p, False
+    return dx, dy, dz, 0.0, 0.0, 0.0, 0.0, False
+
+
+@njit(**_JIT)
+def evaluate(kind, cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz):
+    """``(f_cos r, g, b, pdf)``: :func:`pyoa.render.bsdf.evaluate` for one point."""
+    if oz <= 0.0 or iz <= 0.0 or kind == MIRROR:
+        return 0.0, 0.0, 0.0, 0.0
+    if kind == DIFFUSE:
+        c = iz / math.pi
+        return cr * c, cg * c, cb * c, c
+    if kind == GGX:
+        return ggx_eval(cr, cg, cb, max(alpha, ALPHA_MIN), ox, oy, oz, ix, iy, iz)
+    return 0.0, 0.0, 0.0, 0.0

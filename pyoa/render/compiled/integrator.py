@@ -1,0 +1,331 @@
+"""The wavefront path tracer of :mod:`pyoa.render.integrator`, its shading
+compiled with numba and Embree called from the compiled loops.
+
+Same estimator, same dimension layout and the same guards as the NumPy
+reference (read its docstring): camera rays (box or Gaussian filter, thin
+lens, camera motion), emission seen by a ray with its MIS weight (power
+heuristic), next-event estimation by emitter power, BSDF sampling, Russian
+roulette from depth :data:`~pyoa.render.integrator.RR_DEPTH`. Each bounce is
+three compiled calls over the whole wavefront: closest hits (Embree packets),
+``shade`` (emission, the next-event candidate with its shadow ray, the BSDF
+sample, roulette and the compaction of live lanes), then the shadow rays
+(Embree packets) and ``add_visible``. Every call releases the GIL, so the
+renderer's worker threads keep both cores busy; a lane's result depends only
+on its own row of sampler values, so the image does not depend on the batch
+size, the packet width or the number of threads.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numba import njit
+
+from .. import embree
+from .. import integrator as reference
+from ..bsdf import MIRROR
+from ..integrator import RR_KEY, Stats
+from .bsdf import evaluate, sample
+from .geometry import concentric_disk, frame, triangle_point
+
+_JIT = dict(nogil=True, cache=True)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _mix32(x):
+    """Wellons' lowbias32 on a uint32 held in an int64 (as pyoa.reference.mix32)."""
+    x ^= x >> 16
+    x = (x * 0x7FEB352D) & 0xFFFFFFFF
+    x ^= x >> 15
+    x = (x * 0x846CA68B) & 0xFFFFFFFF
+    x ^= x >> 16
+    return x
+
+
+@njit(nogil=True, cache=True, inline="always")
+def hash_pair(a, b, key):
+    """``mix32(b ^ mix32(a ^ key))``, never 0 (as pyoa.reference.hash_pair)."""
+    h = _mix32((b & 0xFFFFFFFF) ^ _mix32((a & 0xFFFFFFFF) ^ key))
+    return key if h == 0 else h
+
+
+@njit(nogil=True, cache=True, inline="always")
+def power_heuristic(f_pdf, g_pdf):
+    """Veach's power heuristic (beta = 2) for the strategy of density ``f_pdf``."""
+    return f_pdf * f_pdf / (f_pdf * f_pdf + g_pdf * g_pdf)
+
+
+@njit(**_JIT)
+def camera_rays(pixel, u, lens, shutter, width, height, tan_x, tan_y, rot, pos, aperture, focus, motion, o, d):
+    """Camera rays of the lanes (as ``Integrator.camera_rays``): ``u`` the
+    offsets in the pixel (already warped by the filter), ``lens`` the lens
+    samples and ``shutter`` the times (empty when the camera has none)."""
+    has_lens, has_time = lens.shape[0] > 0, shutter.shape[0] > 0
+    for i in range(pixel.shape[0]):
+        fx = ((pixel[i] % width) + u[i, 0]) / width
+        fy = ((pixel[i] // width) + u[i, 1]) / height
+        # Mitsuba's camera space: +z forward, +y up, +x towards the image's left.
+        dx, dy, dz = (1.0 - 2.0 * fx) * tan_x, (1.0 - 2.0 * fy) * tan_y, 1.0
+        ox, oy, oz = 0.0, 0.0, 0.0
+        if has_lens:
+            lx, ly = concentric_disk(lens[i, 0], lens[i, 1])
+            ox, oy = lx * aperture, ly * aperture
+            dx, dy, dz = dx * focus - ox, dy * focus - oy, dz * focus
+        for k in range(3):
+            o[i, k] = ox * rot[k, 0] + oy * rot[k, 1] + oz * rot[k, 2] + pos[k]
+            if has_time:
+                o[i, k] = o[i, k] + shutter[i] * motion[k]
+        wx = dx * rot[0, 0] + dy * rot[0, 1] + dz * rot[0, 2]
+        wy = dx * rot[1, 0] + dy * rot[1, 1] + dz * rot[1, 2]
+        wz = dx * rot[2, 0] + dy * rot[2, 1] + dz * rot[2, 2]
+        n = math.sqrt(wx * wx + wy * wy + wz * wz)
+        n = n if n > 0 else 1.0
+        d[i, 0], d[i, 1], d[i, 2] = wx / n, wy / n, wz / n
+
+
+@njit(nogil=True, cache=True, inline="always")
+def sample_emitter(em, em_cdf, em_prob, verts, normals, areas, u0, u1):
+    """A point on an emitter chosen by power: ``(triangle, point, normal, pdf
+    per unit area)``; ``u0`` picks the triangle and is rescaled to place the
+    point (as ``Integrator._sample_emitter``)."""
+    k = min(np.searchsorted(em_cdf, u0, side="right"), em.shape[0] - 1)
+    lo = em_cdf[k - 1] if k > 0 else 0.0
+    v = min(max((u0 - lo) / (em_cdf[k] - lo), 0.0), np.nextafter(1.0, 0.0))
+    tri = em[k]
+    w0, w1, w2 = triangle_point(v, u1)
+    px = w0 * verts[tri, 0, 0] + w1 * verts[tri, 1, 0] + w2 * verts[tri, 2, 0]
+    py = w0 * verts[tri, 0, 1] + w1 * verts[tri, 1, 1] + w2 * verts[tri, 2, 1]
+    pz = w0 * verts[tri, 0, 2] + w1 * verts[tri, 1, 2] + w2 * verts[tri, 2, 2]
+    return tri, px, py, pz, normals[tri, 0], normals[tri, 1], normals[tri, 2], em_prob[tri] / areas[tri]
+
+
+@njit(**_JIT)
+def shade(n, depth, max_depth, mis, rr_depth, eps,
+          verts, normals, areas, material, emission, kinds, colors, alphas, em, em_cdf, em_prob,
+          x, light_u, light_v, bsdf_u, bsdf_v, sample_index, rr_key,
+          lane, o, d, beta, prev_pdf, prev_delta, prim, t, radiance,
+          sh_o, sh_d, sh_dist, sh_lane, sh_c):
+    """One bounce of ``n`` live lanes whose closest hits are ``prim``/``t``.
+
+    Adds the emission each ray sees (MIS-weighted) to ``radiance``; writes
+    the next-event shadow rays and their contributions (``sh_*``); samples the
+    BSDF, plays Russian roulette and compacts the surviving lanes, in place,
+    to the front of ``lane, o, d, beta, prev_pdf, prev_delta`` with their new
+    rays. Returns ``(live lanes, shadow rays)``. ``light_u`` and the other
+    column indices are -1 where the layout has no such dimension.
+    """
+    live, shadows = 0, 0
+    for i in range(n):
+        tri = prim[i]
+        if tri < 0:
+            continue  # the ray left the scene
+        li = lane[i]
+        dx, dy, dz = d[i, 0], d[i, 1], d[i, 2]
+        ti = t[i]
+        px, py, pz = o[i, 0] + ti * dx, o[i, 1] + ti * dy, o[i, 2] + ti * dz
+        nx, ny, nz = normals[tri, 0], normals[tri, 1], normals[tri, 2]
+        br, bg, bb = beta[i, 0], beta[i, 1], beta[i, 2]
+        # emission seen by this ray (emitters are one-sided)
+        cos_l = -(nx * dx + ny * dy + nz * dz)
+        er, eg, eb = emission[tri, 0], emission[tri, 1], emission[tri, 2]
+        if cos_l > 0 and (er != 0.0 or eg != 0.0 or eb != 0.0):
+            if depth == 1:
+                w = 1.0
+            elif mis:
+                pdf_light = em_prob[tri] / areas[tri] * ti * ti / max(cos_l, 1e-12)
+                pp = prev_pdf[i]
+                w = 1.0 if prev_delta[i] else pp * pp / max(pp * pp + pdf_light * pdf_light, 1e-300)
+            else:
+                w = 1.0 if prev_delta[i] else 0.0  # without MIS only light sampling counts
+            radiance[li, 0] += br * er * w
+            radiance[li, 1] += bg * eg * w
+            radiance[li, 2] += bb * eb * w
+        if depth == max_depth:
+            continue
+        # shading frame facing the incoming ray (two-sided surfaces)
+        if nx * dx + ny * dy + nz * dz > 0:
+            sx, sy, sz = -nx, -ny, -nz
+        else:
+            sx, sy, sz = nx, ny, nz
+        (tx, ty, tz), (bx, by, bz) = frame(sx, sy, sz)
+        wox, woy, woz = -(dx * tx + dy * ty + dz * tz), -(dx * bx + dy * by + dz * bz), -(dx * sx + dy * sy + dz * sz)
+        woz = max(woz, 1e-9)
+        mat = material[tri]
+        kind, alpha = kinds[mat], alphas[mat]
+        cr, cg, cb = colors[mat, 0], colors[mat, 1], colors[mat, 2]
+        row = li
+        # next-event estimation: one point on an emitter
+        if kind != MIRROR:
+            etri, qx, qy, qz, mx, my, mz, pdf_area = sample_emitter(
+                em, em_cdf, em_prob, verts, normals, areas,
+                np.float64(x[row, light_u]), np.float64(x[row, light_v]))
+            vx, vy, vz = qx - px, qy - py, qz - pz
+            dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+            dn = max(dist, 1e-12)
+            wx, wy, wz = vx / dn, vy / dn, vz / dn
+            cos_q = -(mx * wx + my * wy + mz * wz)
+            fr, fg, fb, pdf_b = evaluate(kind, cr, cg, cb, alpha, wox, woy, woz,
+                                         wx * tx + wy * ty + wz * tz, wx * bx + wy * by + wz * bz,
+                                         wx * sx + wy * sy + wz * sz)
+            pdf_l = pdf_area * dist * dist / max(cos_q, 1e-12)
+            if cos_q > 0 and (fr > 0 or fg > 0 or fb > 0):
+                # from p + eps n to q + eps n_q, each moved off its surface
+                side = eps if wx * sx + wy * sy + wz * sz > 0 else -eps
+                ax, ay, az = px + side * sx, py + side * sy, pz + side * sz
+                gx, gy, gz = qx + eps * mx - ax, qy + eps * my - ay, qz + eps * mz - az
+                seg = math.sqrt(gx * gx + gy * gy + gz * gz)
+                sn = max(seg, 1e-12)
+                wl = power_heuristic(pdf_l, pdf_b) if mis else 1.0
+                f = wl / pdf_l
+                sh_o[shadows, 0], sh_o[shadows, 1], sh_o[shadows, 2] = ax, ay, az
+                sh_d[shadows, 0], sh_d[shadows, 1], sh_d[shadows, 2] = gx / sn, gy / sn, gz / sn
+                sh_dist[shadows] = seg * (1 - 1e-4)
+                sh_lane[shadows] = li
+                sh_c[shadows, 0] = br * fr * emission[etri, 0] * f
+                sh_c[shadows, 1] = bg * fg * emission[etri, 1] * f
+                sh_c[shadows, 2] = bb * fb * emission[etri, 2] * f
+                shadows += 1
+        # continue the path with a BSDF sample
+        if not (mis or depth < max_depth - 1):
+            continue
+        ix, iy, iz, wr, wg, wb, pdf, delta = sample(kind, cr, cg, cb, alpha, wox, woy, woz,
+                                                    np.float64(x[row, bsdf_u]), np.float64(x[row, bsdf_v]))
+        br, bg, bb = br * wr, bg * wg, bb * wb
+        alive = br > 0 or bg > 0 or bb > 0
+        if depth >= rr_depth:
+            q = min(max(br, bg, bb), 0.95)
+            h = hash_pair(rr_key[li], sample_index[li] * 64 + depth, RR_KEY)
+            u = (h >> 8) * 2.0**-24
+            alive = alive and u < q
+            if alive:
+                br, bg, bb = br / q, bg / q, bb / q
+        if not alive:
+            continue
+        ox_, oy_, oz_ = ix * tx + iy * bx + iz * sx, ix * ty + iy * by + iz * sy, ix * tz + iy * bz + iz * sz
+        side = eps if ox_ * sx + oy_ * sy + oz_ * sz > 0 else -eps
+        j = live
+        lane[j] = li
+        o[j, 0], o[j, 1], o[j, 2] = px + side * sx, py + side * sy, pz + side * sz
+        d[j, 0], d[j, 1], d[j, 2] = ox_, oy_, oz_
+        beta[j, 0], beta[j, 1], beta[j, 2] = br, bg, bb
+        prev_pdf[j] = pdf
+        prev_delta[j] = delta
+        live += 1
+    return live, shadows
+
+
+@njit(**_JIT)
+def add_visible(m, free, sh_lane, sh_c, radiance):
+    """Add the contributions of the shadow rays that reached their emitter."""
+    for k in range(m):
+        if free[k]:
+            li = sh_lane[k]
+            radiance[li, 0] += sh_c[k, 0]
+            radiance[li, 1] += sh_c[k, 1]
+            radiance[li, 2] += sh_c[k, 2]
+
+
+def packet_width() -> int:
+    """Embree packet width for this CPU: 16 lanes with AVX-512, else 8
+    (the native width of AVX2); see docs/performance.md for the measurements."""
+    from ...hostcpu import host_cpu
+
+    return 16 if host_cpu().isa == "AVX-512" else 8
+
+
+class CompiledIntegrator(reference.Integrator):
+    """The path tracer with compiled shading; same constructor and results as
+    :class:`pyoa.render.integrator.Integrator` (up to floating-point rounding).
+
+    ``width_packet`` is the Embree packet width (1, 4, 8 or 16; default by
+    CPU, :func:`packet_width`). ``timings`` accumulates the seconds spent per
+    stage over every :meth:`radiance` call (``camera``, ``embree``,
+    ``shading``, ``host``).
+    """
+
+    def __init__(self, scene, layout, width, height, filter="box", packet=None):
+        super().__init__(scene, layout, width, height, filter=filter)
+        self.packet = packet_width() if packet is None else packet
+        self.rtc = embree.Scene(scene.triangles)
+        self._fn_hit, self._fn_occ = embree.query_addresses(self.packet)
+        self._verts = np.ascontiguousarray(scene.triangles, dtype=np.float64)
+        m = scene.materials
+        self._mats = (np.ascontiguousarray(m.kind, dtype=np.int64), np.ascontiguousarray(m.color),
+                      np.ascontiguousarray(m.alpha))
+        self._emission = np.ascontiguousarray(scene.emission)
+        self._normals = np.ascontiguousarray(scene.normals)
+        self._areas = np.ascontiguousarray(scene.areas)
+        self._material = np.ascontiguousarray(scene.material, dtype=np.int64)
+        self._em64 = np.ascontiguousarray(self._em, dtype=np.int64)
+        self.timings = {"camera": 0.0, "embree": 0.0, "shading": 0.0, "host": 0.0}
+
+    def radiance(self, pixel, sample_index, x, seed: int = 0):
+        """Radiance (RGB, float64) of the camera paths ``(pixel, sample)`` whose
+        sampler rows are ``x`` (as :meth:`pyoa.render.integrator.Integrator.radiance`)."""
+        L, n = self.layout, len(pixel)
+        clock = time.perf_counter
+        t0 = clock()
+        stats = Stats(paths=n)
+        x = np.ascontiguousarray(x)
+        pixel = np.ascontiguousarray(pixel, dtype=np.int64)
+        u = x[:, list(L.pair("pixel"))].astype(np.float64)
+        if self.filter == "gaussian":
+            from scipy.special import ndtr, ndtri
+
+            lo, hi = ndtr(-4.0), ndtr(4.0)  # +-4 sigma = +-2 pixels
+            u = 0.5 + 0.5 * ndtri(lo + u * (hi - lo))
+        cam = self.scene.camera
+        lens = x[:, list(L.pair("lens"))].astype(np.float64) if L.lens else np.zeros((0, 2))
+        shutter = x[:, L.index("time")].astype(np.float64) if L.time else np.zeros(0)
+        o, d = np.empty((n, 3)), np.empty((n, 3))
+        t1 = clock()
+        camera_rays(pixel, np.ascontiguousarray(u), lens, shutter, self.width, self.height, self._tan_x, self._tan_y,
+                    np.ascontiguousarray(self._cam_rot), np.ascontiguousarray(self._cam_pos), float(cam.aperture),
+                    float(cam.focus_distance), np.asarray(cam.motion, dtype=np.float64), o, d)
+        t2 = clock()
+        tm = self.timings
+        tm["camera"] += t2 - t1
+        radiance = np.zeros((n, 3))
+        lane = np.arange(n, dtype=np.int64)
+        beta = np.ones((n, 3))
+        prev_pdf = np.zeros(n)
+        prev_delta = np.ones(n, dtype=np.bool_)
+        rr_key = reference.hash_pair(reference.U32(seed), pixel.astype(reference.U32), RR_KEY).astype(np.int64)
+        sample_index = np.ascontiguousarray(sample_index, dtype=np.int64)
+        prim, hit_t = np.empty(n, np.int64), np.empty(n)
+        sh_o, sh_d, sh_dist = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        sh_lane, sh_c, free = np.empty(n, np.int64), np.empty((n, 3)), np.empty(n, np.bool_)
+        kinds, colors, alphas = self._mats
+        live = n
+        tm["host"] += clock() - t2 + (t1 - t0)
+        for depth in range(1, L.max_depth + 1):
+            if live == 0:
+                break
+            t0 = clock()
+            embree.intersect(self.rtc.handle, self._fn_hit, self.packet, o[:live], d[:live], prim, hit_t)
+            stats.rays += live
+            t1 = clock()
+            cols = [-1, -1, -1, -1]
+            if depth < L.max_depth:
+                cols[:2] = L.pair(f"light{depth}")
+                if f"bsdf{depth}.u" in L:
+                    cols[2:] = L.pair(f"bsdf{depth}")
+            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self._eps,
+                                  self._verts, self._normals, self._areas, self._material, self._emission,
+                                  kinds, colors, alphas, self._em64, self._em_cdf, self._em_prob,
+                                  x, *cols, sample_index, rr_key,
+                                  lane, o, d, beta, prev_pdf, prev_delta, prim, hit_t, radiance,
+                                  sh_o, sh_d, sh_dist, sh_lane, sh_c)
+            t2 = clock()
+            if shadows:
+                embree.occluded(self.rtc.handle, self._fn_occ, self.packet, sh_o[:shadows], sh_d[:shadows],
+                                sh_dist[:shadows], free)
+                stats.rays += shadows
+            t3 = clock()
+            add_visible(shadows, free, sh_lane, sh_c, radiance)
+            t4 = clock()
+            tm["embree"] += (t1 - t0) + (t3 - t2)
+            tm["shading"] += (t2 - t1) + (t4 - t3)
+        return radiance, stats

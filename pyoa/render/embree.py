@@ -1,0 +1,304 @@
+"""Embree 4 called from numba-compiled code: the scene, and closest-hit and
+occlusion queries over whole wavefronts without returning to Python.
+
+The ``embreex`` wheel ships Embree 4 (``embreex.libs/libembree4-*.so.4``) with
+its whole C API, but binds only the single-ray queries behind one Python call
+per wavefront (``EmbreeScene.run``). Here the *same* library (the one
+``embreex`` loaded, found in the process's memory map) is opened with
+:mod:`ctypes`; the scene is built with Embree's own calls, and the compiled
+tracing loops call ``rtcIntersect{1,4,8,16}`` / ``rtcOccluded{1,4,8,16}``
+through their addresses, which are passed in as integers so that numba's
+on-disk cache stays valid across processes (addresses baked into compiled
+code would not).
+
+Ray layout (Embree 4's ``rtcore_ray.h``): a ray is the 12 four-byte fields
+``org_x org_y org_z tnear dir_x dir_y dir_z time tfar mask id flags``, a hit
+the fields ``Ng_x Ng_y Ng_z u v primID geomID instID[1] instPrimID[1]``; a
+packet of width W stores each field as an array of W (structure of arrays),
+aligned to 4 W bytes. A miss leaves ``geomID`` at ``RTC_INVALID_GEOMETRY_ID``
+(0xFFFFFFFF); an occluded ray gets ``tfar = -inf``. ``tests/render/test_embree.py``
+checks this layout against ``embreex.run``.
+
+References
+----------
+.. [1] Intel, "Embree API reference", version 4 (rtcIntersect1/4/8/16,
+   rtcOccluded1/4/8/16, RTCRayHit, RTCRayHitN).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import glob
+import os
+
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
+
+#: Packet widths Embree offers, and the four-byte fields of a ray and of a hit.
+WIDTHS = (1, 4, 8, 16)
+RAY_FIELDS = 12
+HIT_FIELDS = 9  # Ng_x Ng_y Ng_z u v primID geomID instID[1] instPrimID[1]
+#: Field indices (in units of W four-byte words from the start of a packet).
+ORG_X, ORG_Y, ORG_Z, TNEAR, DIR_X, DIR_Y, DIR_Z, TIME, TFAR, MASK, ID, FLAGS = range(12)
+PRIM_ID, GEOM_ID = RAY_FIELDS + 5, RAY_FIELDS + 6
+INVALID_ID = 0xFFFFFFFF
+
+# Embree enums (rtcore_device.h, rtcore_geometry.h, rtcore_buffer.h).
+_GEOMETRY_TYPE_TRIANGLE = 0
+_BUFFER_TYPE_INDEX, _BUFFER_TYPE_VERTEX = 0, 1
+_FORMAT_UINT3, _FORMAT_FLOAT3 = 0x5003, 0x9003
+_SCENE_FLAG_ROBUST = 1 << 2
+
+
+class EmbreeUnavailable(RuntimeError):
+    """The Embree library that embreex ships cannot be used from compiled code."""
+
+
+@functools.lru_cache(maxsize=1)
+def library_path() -> str:
+    """Path of the Embree 4 library that ``embreex`` loaded into this process.
+
+    Raises
+    ------
+    EmbreeUnavailable
+        If embreex is not installed or its Embree library is not found.
+    """
+    try:
+        import embreex.rtcore_scene  # noqa: F401 - loads libembree4
+    except ImportError as exc:
+        raise EmbreeUnavailable(f"embreex is not installed ({exc}); pip install embreex") from exc
+    try:
+        with open("/proc/self/maps", encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                path = line.split(maxsplit=5)[-1].strip()
+                if "libembree4" in os.path.basename(path) and os.path.exists(path):
+                    return path
+    except OSError:
+        pass
+    import embreex
+
+    found = sorted(glob.glob(os.path.join(os.path.dirname(os.path.dirname(embreex.__file__)), "embreex.libs",
+                                          "libembree4*")))
+    if not found:
+        raise EmbreeUnavailable("embreex's Embree 4 library (libembree4) was not found in memory or beside it")
+    return found[0]
+
+
+@functools.lru_cache(maxsize=1)
+def library() -> ctypes.CDLL:
+    """The Embree library (the one ``embreex`` loaded) with the signatures pyoa uses."""
+    lib = ctypes.CDLL(library_path())
+    vp, u32, sz = ctypes.c_void_p, ctypes.c_uint, ctypes.c_size_t
+    for name, res, args in (
+        ("rtcNewDevice", vp, [ctypes.c_char_p]),
+        ("rtcReleaseDevice", None, [vp]),
+        ("rtcGetDeviceError", ctypes.c_int, [vp]),
+        ("rtcNewScene", vp, [vp]),
+        ("rtcReleaseScene", None, [vp]),
+        ("rtcCommitScene", None, [vp]),
+        ("rtcSetSceneFlags", None, [vp, ctypes.c_int]),
+        ("rtcNewGeometry", vp, [vp, ctypes.c_int]),
+        ("rtcSetNewGeometryBuffer", vp, [vp, ctypes.c_int, u32, ctypes.c_int, sz, sz]),
+        ("rtcCommitGeometry", None, [vp]),
+        ("rtcAttachGeometry", u32, [vp, vp]),
+        ("rtcReleaseGeometry", None, [vp]),
+    ):
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = res, args
+    return lib
+
+
+def query_addresses(width: int) -> tuple[int, int]:
+    """Addresses of ``rtcIntersect<W>`` and ``rtcOccluded<W>`` for a packet width."""
+    if width not in WIDTHS:
+        raise ValueError(f"Embree packet width must be one of {WIDTHS}, got {width!r}")
+    lib = library()
+    return (ctypes.cast(getattr(lib, f"rtcIntersect{width}"), ctypes.c_void_p).value,
+            ctypes.cast(getattr(lib, f"rtcOccluded{width}"), ctypes.c_void_p).value)
+
+
+class Scene:
+    """A triangle scene built with Embree's own calls (one geometry, static).
+
+    Parameters
+    ----------
+    triangles : array_like
+        ``(T, 3, 3)`` world-space vertices; they are converted to float32
+        exactly as ``embreex`` does.
+
+    ``handle`` is the ``RTCScene`` as an integer, for the compiled queries.
+    The scene keeps its device and buffers alive until :meth:`close` (or
+    garbage collection).
+    """
+
+    def __init__(self, triangles):
+        lib = library()
+        tris = np.ascontiguousarray(triangles, dtype=np.float32).reshape(-1, 3, 3)
+        if len(tris) == 0:
+            raise ValueError("an Embree scene needs at least one triangle")
+        self._lib = lib
+        self._device = lib.rtcNewDevice(None)
+        if not self._device:
+            raise EmbreeUnavailable(f"rtcNewDevice failed (Embree error {lib.rtcGetDeviceError(None)})")
+        try:
+            self._scene = lib.rtcNewScene(self._device)
+            # Robust traversal, as embreex's scenes: the same hits as the NumPy
+            # reference's (tested), also at ties between coplanar triangles.
+            lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST)
+            geom = lib.rtcNewGeometry(self._device, _GEOMETRY_TYPE_TRIANGLE)
+            vb = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3, 12, 3 * len(tris))
+            ib = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3, 12, len(tris))
+            if not vb or not ib:
+                raise EmbreeUnavailable(f"Embree could not allocate the scene's buffers "
+                                        f"(error {lib.rtcGetDeviceError(self._device)})")
+            # Embree owns these buffers (and pads the vertex buffer as it needs).
+            ctypes.memmove(vb, tris.ctypes.data, tris.nbytes)
+            idx = np.arange(3 * len(tris), dtype=np.uint32)
+            ctypes.memmove(ib, idx.ctypes.data, idx.nbytes)
+            lib.rtcCommitGeometry(geom)
+            lib.rtcAttachGeometry(self._scene, geom)
+            lib.rtcReleaseGeometry(geom)
+            lib.rtcCommitScene(self._scene)
+            err = lib.rtcGetDeviceError(self._device)
+            if err:
+                raise EmbreeUnavailable(f"Embree could not build the scene (error {err})")
+        except BaseException:
+            self.close()
+            raise
+        self.handle = int(self._scene)
+        self.triangles = len(tris)
+
+    def close(self) -> None:
+        """Release the scene and its device (idempotent)."""
+        if getattr(self, "_scene", None):
+            self._lib.rtcReleaseScene(self._scene)
+            self._scene = None
+        if getattr(self, "_device", None):
+            self._lib.rtcReleaseDevice(self._device)
+            self._device = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+
+# ----------------------------------------------------------------------------- compiled queries
+
+
+@intrinsic
+def _ccall3(typingctx, fn, a, b, c):
+    """``((void (*)(void *, void *, void *)) fn)(a, b, c)`` with every argument a uint64 address."""
+    sig = types.void(types.uint64, types.uint64, types.uint64, types.uint64)
+
+    def codegen(context, builder, signature, args):
+        ptr = ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [ptr, ptr, ptr])
+        f = builder.inttoptr(args[0], fnty.as_pointer())
+        builder.call(f, [builder.inttoptr(x, ptr) for x in args[1:]])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def _ccall4(typingctx, fn, a, b, c, d):
+    """``((void (*)(void *, void *, void *, void *)) fn)(a, b, c, d)``, uint64 addresses."""
+    sig = types.void(types.uint64, types.uint64, types.uint64, types.uint64, types.uint64)
+
+    def codegen(context, builder, signature, args):
+        ptr = ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [ptr, ptr, ptr, ptr])
+        f = builder.inttoptr(args[0], fnty.as_pointer())
+        builder.call(f, [builder.inttoptr(x, ptr) for x in args[1:]])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@njit(nogil=True, cache=True)
+def _packet_buffer(width):
+    """A zeroed float32 packet of ``width`` rays with hits, aligned to 64
+    bytes, and its uint32 view (Embree requires 4 W-byte alignment)."""
+    words = (RAY_FIELDS + HIT_FIELDS) * width
+    raw = np.zeros(words + 16, np.float32)
+    skip = ((64 - (raw.ctypes.data & 63)) & 63) // 4
+    buf = raw[skip:skip + words]
+    return buf, buf.view(np.uint32)
+
+
+@njit(nogil=True, cache=True)
+def _load(buf, bits, width, k, o, d, i, tfar):
+    """Ray ``i`` of the wavefront into lane ``k`` of the packet."""
+    buf[ORG_X * width + k] = o[i, 0]
+    buf[ORG_Y * width + k] = o[i, 1]
+    buf[ORG_Z * width + k] = o[i, 2]
+    buf[TNEAR * width + k] = 0.0
+    buf[DIR_X * width + k] = d[i, 0]
+    buf[DIR_Y * width + k] = d[i, 1]
+    buf[DIR_Z * width + k] = d[i, 2]
+    buf[TIME * width + k] = 0.0
+    buf[TFAR * width + k] = tfar
+    bits[MASK * width + k] = 0xFFFFFFFF
+    bits[ID * width + k] = 0
+    bits[FLAGS * width + k] = 0
+    bits[GEOM_ID * width + k] = INVALID_ID
+    bits[PRIM_ID * width + k] = INVALID_ID
+
+
+@njit(nogil=True, cache=True)
+def intersect(scene, fn, width, o, d, prim, t):
+    """Closest hits of the rays ``o + s d`` (``(n, 3)`` float64, converted to
+    float32 like ``embreex``): ``prim[i]`` the triangle (-1 for a miss) and
+    ``t[i]`` the distance (inf for a miss). ``fn`` is the address of
+    ``rtcIntersect<width>``. Every ray's answer depends on that ray alone."""
+    n = o.shape[0]
+    buf, bits = _packet_buffer(width)
+    valid = np.empty(max(width, 1), np.int32)
+    inf = np.float32(np.inf)
+    for start in range(0, n, width):
+        m = min(width, n - start)
+        for k in range(width):
+            if k < m:
+                _load(buf, bits, width, k, o, d, start + k, inf)
+                valid[k] = -1
+            else:
+                valid[k] = 0
+        if width == 1:
+            _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+        else:
+            _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+        for k in range(m):
+            if bits[GEOM_ID * width + k] == INVALID_ID:
+                prim[start + k] = -1
+                t[start + k] = np.inf
+            else:
+                prim[start + k] = np.int64(bits[PRIM_ID * width + k])
+                t[start + k] = np.float64(buf[TFAR * width + k])
+
+
+@njit(nogil=True, cache=True)
+def occluded(scene, fn, width, o, d, dist, free):
+    """``free[i]`` is True where nothing blocks ``o + s d`` for ``0 <= s <=
+    dist[i]`` (float32 as ``embreex``); ``fn`` is ``rtcOccluded<width>``."""
+    n = o.shape[0]
+    buf, bits = _packet_buffer(width)  # a ray packet is a prefix of a ray-hit packet
+    valid = np.empty(max(width, 1), np.int32)
+    for start in range(0, n, width):
+        m = min(width, n - start)
+        for k in range(width):
+            if k < m:
+                _load(buf, bits, width, k, o, d, start + k, np.float32(dist[start + k]))
+                valid[k] = -1
+            else:
+                valid[k] = 0
+        if width == 1:
+            _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+        else:
+            _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+        for k in range(m):
+            free[start + k] = buf[TFAR * width + k] >= 0.0

@@ -1,0 +1,149 @@
+"""The compiled shading (pyoa.render.compiled) against the NumPy reference:
+the BSDFs function by function, the renders within the noise they predict,
+determinism over packet widths, batches and threads, and the choice of
+shading (argument, PYOA_SHADING, the fallback when numba is missing)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from pyoa.render import bsdf as nb_ref
+from pyoa.render.compiled import bsdf as cb
+from pyoa.render.compiled import integrator as ci
+from pyoa.render.render import render
+from pyoa.render.scene import load
+
+KINDS = (nb_ref.DIFFUSE, nb_ref.MIRROR, nb_ref.GGX)
+
+
+def _directions(rng, n):
+    wo = rng.normal(size=(n, 3))
+    wo[:, 2] = np.abs(wo[:, 2])
+    wo[: n // 20, 2] = 1e-9  # grazing
+    wo /= np.linalg.norm(wo, axis=1)[:, None]
+    return wo
+
+
+@pytest.mark.parametrize("alpha", [1e-4, 0.05, 0.3, 1.0])
+def test_bsdf_sample_and_evaluate_mirror_the_reference(alpha):
+    rng = np.random.default_rng(int(alpha * 1e4))
+    n = 600
+    color = np.array([0.9, 0.5, 0.2])
+    mats = nb_ref.Materials.build([("d", "diffuse", color, 0.5), ("m", "mirror", color, 0.5),
+                                   ("g", "ggx", color, alpha)])
+    wo = _directions(rng, n)
+    wi_any = rng.normal(size=(n, 3))
+    wi_any /= np.linalg.norm(wi_any, axis=1)[:, None]
+    u = rng.random((n, 2))
+    u[:5] = [[0.5, 0.5], [0.0, 0.0], [0.5, 0.0], [0.0, 0.5], [np.nextafter(1, 0)] * 2]  # warp corners
+    for kind, mat in zip(KINDS, range(3)):
+        ids = np.full(n, mat)
+        wi, weight, pdf, delta = nb_ref.sample(mats, ids, wo, u)
+        f_cos, pdf_e = nb_ref.evaluate(mats, ids, wo, wi_any)
+        for i in range(n):
+            got = cb.sample(kind, *color, mats.alpha[mat], *wo[i], *u[i])
+            np.testing.assert_allclose(got[:3], wi[i], rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(got[3:6], weight[i], rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(got[6], pdf[i], rtol=1e-12, atol=1e-15)
+            assert got[7] == delta[i]
+            ev = cb.evaluate(kind, *color, mats.alpha[mat], *wo[i], *wi_any[i])
+            np.testing.assert_allclose(ev[:3], f_cos[i], rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(ev[3], pdf_e[i], rtol=1e-12, atol=1e-15)
+
+
+def _noise_check(scene, **kw):
+    """Render ``scene`` with both shadings over independent seeds and check the
+    difference of the two means against the noise both predict, per pixel
+    (a t statistic from the spread over seeds) and for the image mean."""
+    seeds = 8
+    means = {}
+    for shading, base in (("numba", 0), ("numpy", 1000)):
+        imgs = np.stack([render(scene, seed=base + k, shading=shading, **kw).image.astype(np.float64)
+                         for k in range(seeds)])
+        means[shading] = (imgs.mean(axis=0), imgs.var(axis=0, ddof=1) / seeds)
+    (ma, va), (mb, vb) = means["numba"], means["numpy"]
+    var = va + vb
+    lit = var > 0
+    z = np.abs(ma - mb)[lit] / np.sqrt(var[lit])
+    assert np.all(ma[~lit] == mb[~lit]), "pixels without noise must agree exactly (both black, or constant)"
+    # t with 2 x 7 degrees of freedom: P(|t| > 5) is about 2e-4 per pixel
+    assert np.mean(z > 5) < 0.005, f"{np.mean(z > 5):.4f} of the pixels differ by more than 5 sigma"
+    for c in range(3):
+        se = np.sqrt(var[..., c].sum()) / var[..., c].size
+        diff = abs(ma[..., c].mean() - mb[..., c].mean())
+        assert diff <= 5 * se + 1e-7, f"channel {c}: image means differ by {diff:.3g}, standard error {se:.3g}"
+
+
+@pytest.mark.parametrize("name", ["cornell", "dof7d", "deep"])
+def test_compiled_and_numpy_agree_within_their_noise(name):
+    _noise_check(load(name), sampler="bose", spp=25, width=24, height=24)
+
+
+def test_packet_widths_batches_and_threads_give_the_same_bits(monkeypatch):
+    sc = load("deep")  # GGX, mirror, long paths, Russian roulette
+    kw = dict(sampler="bose", spp=9, seed=4, width=16, height=16, shading="numba")
+    ref = render(sc, **kw, threads=1).image.tobytes()
+    for width in (1, 4, 8, 16):
+        monkeypatch.setattr(ci, "packet_width", lambda w=width: w)
+        for batch_paths, threads in ((9 * 7, 2), (1 << 16, 2), (1, 1)):
+            img = render(sc, **kw, batch_paths=batch_paths, threads=threads).image
+            assert img.tobytes() == ref, f"packet {width}, batch_paths={batch_paths}, threads={threads}"
+
+
+def test_timings_cover_the_stages():
+    res = render(load("cornell"), sampler="bose", spp=4, width=16, height=16, shading="numba")
+    assert set(res.timings) == {"camera", "embree", "shading", "host"}
+    assert all(v >= 0 for v in res.timings.values()) and res.timings["embree"] > 0
+    assert render(load("cornell"), sampler="bose", spp=4, width=8, height=8, shading="numpy").timings == {}
+
+
+def test_shading_argument_and_environment(monkeypatch):
+    sc = load("cornell")
+    with pytest.raises(ValueError, match=r"unknown shading 'gpu'; valid: numba, numpy"):
+        render(sc, sampler="bose", spp=4, width=4, height=4, shading="gpu")
+    with pytest.raises(TypeError, match="shading must be a str"):
+        render(sc, sampler="bose", spp=4, width=4, height=4, shading=1)
+    monkeypatch.setenv("PYOA_SHADING", "bogus")
+    with pytest.raises(ValueError, match=r"unknown \$PYOA_SHADING 'bogus'"):
+        render(sc, sampler="bose", spp=4, width=4, height=4)
+    monkeypatch.setenv("PYOA_SHADING", " NumPy ")
+    assert render(sc, sampler="bose", spp=4, width=4, height=4).shading == "numpy"
+    monkeypatch.delenv("PYOA_SHADING")
+    assert render(sc, sampler="bose", spp=4, width=4, height=4).shading == "numba"
+
+
+SCRIPT = textwrap.dedent("""
+    import warnings
+    warnings.simplefilter("always")
+    from pyoa.render.render import render
+    from pyoa.render.scene import load
+    with warnings.catch_warnings(record=True) as rec:
+        res = render(load("cornell"), sampler="bose", spp=4, width=8, height=8, backend="numpy")
+    print("SHADING", res.shading)
+    for w in rec:
+        print("WARNING", w.category.__name__, str(w.message).replace("\\n", " | "))
+    try:
+        render(load("cornell"), sampler="bose", spp=4, width=8, height=8, backend="numpy", shading="numba")
+    except RuntimeError as exc:
+        print("RAISED", exc)
+""")
+
+
+def test_without_numba_the_reference_renders_with_one_warning(tmp_path):
+    """numba hidden for real (an import that fails) in a subprocess."""
+    (tmp_path / "numba.py").write_text("raise ImportError('numba hidden by the test suite')\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYOA_")}
+    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path)] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
+    res = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert "SHADING numpy" in res.stdout
+    warns = [ln for ln in res.stdout.splitlines() if ln.startswith("WARNING")]
+    assert len(warns) == 1 and "ShadingFallbackWarning" in warns[0] and "numba hidden" in warns[0], res.stdout
+    assert "PYOA_SHADING=numpy" in warns[0]
+    assert "RAISED compiled shading is not usable here" in res.stdout
