@@ -19,7 +19,9 @@ from ..bsdf import ALPHA_MIN, DIFFUSE, GGX, MIRROR
 from .geometry import concentric_disk
 
 _TINY = 1e-300
-_JIT = dict(nogil=True, cache=True, inline="always")
+#: error_model="numpy": divisions follow IEEE (as the NumPy reference's do)
+#: instead of numba's default per-division ZeroDivisionError check.
+_JIT = dict(nogil=True, cache=True, inline="always", error_model="numpy")
 
 
 @njit(**_JIT)

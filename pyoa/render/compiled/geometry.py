@@ -6,7 +6,9 @@ import math
 
 from numba import njit
 
-_JIT = dict(nogil=True, cache=True, inline="always")
+#: error_model="numpy": divisions follow IEEE (as the NumPy reference's do)
+#: instead of numba's default per-division ZeroDivisionError check.
+_JIT = dict(nogil=True, cache=True, inline="always", error_model="numpy")
 
 
 @njit(**_JIT)

@@ -27,13 +27,19 @@ from .. import embree
 from .. import integrator as reference
 from ..bsdf import MIRROR
 from ..integrator import RR_KEY, Stats
+
+#: The largest float64 below 1 (the emitter sample is clamped to [0, 1) like the reference).
+_BELOW_ONE = float(np.nextafter(1.0, 0.0))
 from .bsdf import evaluate, sample
 from .geometry import concentric_disk, frame, triangle_point
 
-_JIT = dict(nogil=True, cache=True)
+#: error_model="numpy": IEEE divisions, as the NumPy reference's (numba's
+#: default checks every division for zero and raises).
+_JIT = dict(nogil=True, cache=True, error_model="numpy")
+_INLINE = dict(_JIT, inline="always")
 
 
-@njit(nogil=True, cache=True, inline="always")
+@njit(**_INLINE)
 def _mix32(x):
     """Wellons' lowbias32 on a uint32 held in an int64 (as pyoa.reference.mix32)."""
     x ^= x >> 16
@@ -44,14 +50,14 @@ def _mix32(x):
     return x
 
 
-@njit(nogil=True, cache=True, inline="always")
+@njit(**_INLINE)
 def hash_pair(a, b, key):
     """``mix32(b ^ mix32(a ^ key))``, never 0 (as pyoa.reference.hash_pair)."""
     h = _mix32((b & 0xFFFFFFFF) ^ _mix32((a & 0xFFFFFFFF) ^ key))
     return key if h == 0 else h
 
 
-@njit(nogil=True, cache=True, inline="always")
+@njit(**_INLINE)
 def power_heuristic(f_pdf, g_pdf):
     """Veach's power heuristic (beta = 2) for the strategy of density ``f_pdf``."""
     return f_pdf * f_pdf / (f_pdf * f_pdf + g_pdf * g_pdf)
@@ -85,14 +91,14 @@ def camera_rays(pixel, u, lens, shutter, width, height, tan_x, tan_y, rot, pos, 
         d[i, 0], d[i, 1], d[i, 2] = wx / n, wy / n, wz / n
 
 
-@njit(nogil=True, cache=True, inline="always")
+@njit(**_INLINE)
 def sample_emitter(em, em_cdf, em_prob, verts, normals, areas, u0, u1):
     """A point on an emitter chosen by power: ``(triangle, point, normal, pdf
     per unit area)``; ``u0`` picks the triangle and is rescaled to place the
     point (as ``Integrator._sample_emitter``)."""
     k = min(np.searchsorted(em_cdf, u0, side="right"), em.shape[0] - 1)
     lo = em_cdf[k - 1] if k > 0 else 0.0
-    v = min(max((u0 - lo) / (em_cdf[k] - lo), 0.0), np.nextafter(1.0, 0.0))
+    v = min(max((u0 - lo) / (em_cdf[k] - lo), 0.0), _BELOW_ONE)
     tri = em[k]
     w0, w1, w2 = triangle_point(v, u1)
     px = w0 * verts[tri, 0, 0] + w1 * verts[tri, 1, 0] + w2 * verts[tri, 2, 0]
