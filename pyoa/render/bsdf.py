@@ -97,6 +97,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import concentric_disk
+
 __all__ = ["DIFFUSE", "MIRROR", "GGX", "KINDS", "ALPHA_MIN", "Materials", "sample", "evaluate"]
 
 DIFFUSE, MIRROR, GGX = 0, 1, 2
@@ -196,20 +198,6 @@ class Materials:
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _concentric_disk(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Shirley-Chiu concentric mapping of ``u`` in ``[0,1)^2`` to the unit disk (PBR 13.6.2)."""
-    a = 2.0 * u[:, 0] - 1.0
-    b = 2.0 * u[:, 1] - 1.0
-    first = np.abs(a) > np.abs(b)
-    r = np.where(first, a, b)
-    safe_a = np.where(a == 0.0, 1.0, a)
-    safe_b = np.where(b == 0.0, 1.0, b)
-    phi = np.where(first, (np.pi / 4.0) * (b / safe_a), np.pi / 2.0 - (np.pi / 4.0) * (a / safe_b))
-    origin = (a == 0.0) & (b == 0.0)
-    r = np.where(origin, 0.0, r)
-    return r * np.cos(phi), r * np.sin(phi)
 
 
 def _ggx_lambda_root(w: np.ndarray, alpha: np.ndarray) -> np.ndarray:
@@ -335,7 +323,7 @@ def sample(mats: Materials, mat: np.ndarray, wo: np.ndarray, u: np.ndarray):
 
     m = _lanes((kind == DIFFUSE) & valid)
     if m is not None:
-        x, y = _concentric_disk(u[m])
+        x, y = concentric_disk(u[m]).T
         z = np.sqrt(np.maximum(0.0, 1.0 - x * x - y * y))
         d = np.stack([x, y, z], axis=1)
         wi[m] = d / np.linalg.norm(d, axis=1)[:, None]

@@ -26,12 +26,12 @@ from numba import njit
 from .. import embree
 from .. import integrator as reference
 from ..bsdf import MIRROR
+from ..camera import filter_offsets
 from ..integrator import RR_KEY, Stats
-
-#: The largest float64 below 1 (the emitter sample is clamped to [0, 1) like the reference).
-_BELOW_ONE = float(np.nextafter(1.0, 0.0))
 from .bsdf import evaluate, sample
-from .geometry import concentric_disk, frame, triangle_point
+from .camera import camera_rays
+from .emitters import sample_emitter
+from .geometry import frame
 
 #: error_model="numpy": IEEE divisions, as the NumPy reference's (numba's
 #: default checks every division for zero and raises).
@@ -59,52 +59,30 @@ def hash_pair(a, b, key):
 
 @njit(**_INLINE)
 def power_heuristic(f_pdf, g_pdf):
-    """Veach's power heuristic (beta = 2) for the strategy of density ``f_pdf``."""
-    return f_pdf * f_pdf / (f_pdf * f_pdf + g_pdf * g_pdf)
-
-
-@njit(**_JIT)
-def camera_rays(pixel, u, lens, shutter, width, height, tan_x, tan_y, rot, pos, aperture, focus, motion, o, d):
-    """Camera rays of the lanes (as ``Integrator.camera_rays``): ``u`` the
-    offsets in the pixel (already warped by the filter), ``lens`` the lens
-    samples and ``shutter`` the times (empty when the camera has none)."""
-    has_lens, has_time = lens.shape[0] > 0, shutter.shape[0] > 0
-    for i in range(pixel.shape[0]):
-        fx = ((pixel[i] % width) + u[i, 0]) / width
-        fy = ((pixel[i] // width) + u[i, 1]) / height
-        # Mitsuba's camera space: +z forward, +y up, +x towards the image's left.
-        dx, dy, dz = (1.0 - 2.0 * fx) * tan_x, (1.0 - 2.0 * fy) * tan_y, 1.0
-        ox, oy, oz = 0.0, 0.0, 0.0
-        if has_lens:
-            lx, ly = concentric_disk(lens[i, 0], lens[i, 1])
-            ox, oy = lx * aperture, ly * aperture
-            dx, dy, dz = dx * focus - ox, dy * focus - oy, dz * focus
-        for k in range(3):
-            o[i, k] = ox * rot[k, 0] + oy * rot[k, 1] + oz * rot[k, 2] + pos[k]
-            if has_time:
-                o[i, k] = o[i, k] + shutter[i] * motion[k]
-        wx = dx * rot[0, 0] + dy * rot[0, 1] + dz * rot[0, 2]
-        wy = dx * rot[1, 0] + dy * rot[1, 1] + dz * rot[1, 2]
-        wz = dx * rot[2, 0] + dy * rot[2, 1] + dz * rot[2, 2]
-        n = math.sqrt(wx * wx + wy * wy + wz * wz)
-        n = n if n > 0 else 1.0
-        d[i, 0], d[i, 1], d[i, 2] = wx / n, wy / n, wz / n
+    """Veach's power heuristic (beta = 2), as ``integrator.power_heuristic``."""
+    return f_pdf * f_pdf / max(f_pdf * f_pdf + g_pdf * g_pdf, 1e-300)
 
 
 @njit(**_INLINE)
-def sample_emitter(em, em_cdf, em_prob, verts, normals, areas, u0, u1):
-    """A point on an emitter chosen by power: ``(triangle, point, normal, pdf
-    per unit area)``; ``u0`` picks the triangle and is rescaled to place the
-    point (as ``Integrator._sample_emitter``)."""
-    k = min(np.searchsorted(em_cdf, u0, side="right"), em.shape[0] - 1)
-    lo = em_cdf[k - 1] if k > 0 else 0.0
-    v = min(max((u0 - lo) / (em_cdf[k] - lo), 0.0), _BELOW_ONE)
-    tri = em[k]
-    w0, w1, w2 = triangle_point(v, u1)
-    px = w0 * verts[tri, 0, 0] + w1 * verts[tri, 1, 0] + w2 * verts[tri, 2, 0]
-    py = w0 * verts[tri, 0, 1] + w1 * verts[tri, 1, 1] + w2 * verts[tri, 2, 1]
-    pz = w0 * verts[tri, 0, 2] + w1 * verts[tri, 1, 2] + w2 * verts[tri, 2, 2]
-    return tri, px, py, pz, normals[tri, 0], normals[tri, 1], normals[tri, 2], em_prob[tri] / areas[tri]
+def emission_weight(depth, mis, pdf_light, prev_pdf, prev_delta):
+    """MIS weight of emission reached by a BSDF sample (as
+    ``Integrator.emission_weight``)."""
+    if depth == 1:
+        return 1.0
+    if not mis:
+        return 1.0 if prev_delta else 0.0  # without MIS only light sampling counts
+    return 1.0 if prev_delta else power_heuristic(prev_pdf, pdf_light)
+
+
+@njit(**_INLINE)
+def russian_roulette(br, bg, bb, key, sample_index, depth):
+    """``(alive, beta r, g, b)``: survival with probability ``min(max beta,
+    0.95)`` from a hash of the path (as ``integrator.russian_roulette``)."""
+    q = min(max(br, bg, bb), 0.95)
+    h = hash_pair(key, sample_index * 64 + depth, RR_KEY)
+    if (h >> 8) * 2.0**-24 < q:
+        return True, br / q, bg / q, bb / q
+    return False, br, bg, bb
 
 
 @njit(**_JIT)
@@ -137,14 +115,8 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
         cos_l = -(nx * dx + ny * dy + nz * dz)
         er, eg, eb = emission[tri, 0], emission[tri, 1], emission[tri, 2]
         if cos_l > 0 and (er != 0.0 or eg != 0.0 or eb != 0.0):
-            if depth == 1:
-                w = 1.0
-            elif mis:
-                pdf_light = em_prob[tri] / areas[tri] * ti * ti / max(cos_l, 1e-12)
-                pp = prev_pdf[i]
-                w = 1.0 if prev_delta[i] else pp * pp / max(pp * pp + pdf_light * pdf_light, 1e-300)
-            else:
-                w = 1.0 if prev_delta[i] else 0.0  # without MIS only light sampling counts
+            pdf_light = em_prob[tri] / areas[tri] * ti * ti / max(cos_l, 1e-12)
+            w = emission_weight(depth, mis, pdf_light, prev_pdf[i], prev_delta[i])
             radiance[li, 0] += br * er * w
             radiance[li, 1] += bg * eg * w
             radiance[li, 2] += bb * eb * w
@@ -200,13 +172,8 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
                                                     np.float64(x[row, bsdf_u]), np.float64(x[row, bsdf_v]))
         br, bg, bb = br * wr, bg * wg, bb * wb
         alive = br > 0 or bg > 0 or bb > 0
-        if depth >= rr_depth:
-            q = min(max(br, bg, bb), 0.95)
-            h = hash_pair(rr_key[li], sample_index[li] * 64 + depth, RR_KEY)
-            u = (h >> 8) * 2.0**-24
-            alive = alive and u < q
-            if alive:
-                br, bg, bb = br / q, bg / q, bb / q
+        if alive and depth >= rr_depth:
+            alive, br, bg, bb = russian_roulette(br, bg, bb, rr_key[li], sample_index[li], depth)
         if not alive:
             continue
         ox_, oy_, oz_ = ix * tx + iy * bx + iz * sx, ix * ty + iy * by + iz * sy, ix * tz + iy * bz + iz * sz
@@ -264,7 +231,9 @@ class CompiledIntegrator(reference.Integrator):
         self._normals = np.ascontiguousarray(scene.normals)
         self._areas = np.ascontiguousarray(scene.areas)
         self._material = np.ascontiguousarray(scene.material, dtype=np.int64)
-        self._em64 = np.ascontiguousarray(self._em, dtype=np.int64)
+        em = self.emitters
+        self._em = (np.ascontiguousarray(em.index, dtype=np.int64), np.ascontiguousarray(em.cdf),
+                    np.ascontiguousarray(em.prob))
         self.timings = {"camera": 0.0, "embree": 0.0, "shading": 0.0, "host": 0.0}
 
     def radiance(self, pixel, sample_index, x, seed: int = 0):
@@ -276,20 +245,14 @@ class CompiledIntegrator(reference.Integrator):
         stats = Stats(paths=n)
         x = np.ascontiguousarray(x)
         pixel = np.ascontiguousarray(pixel, dtype=np.int64)
-        u = x[:, list(L.pair("pixel"))].astype(np.float64)
-        if self.filter == "gaussian":
-            from scipy.special import ndtr, ndtri
-
-            lo, hi = ndtr(-4.0), ndtr(4.0)  # +-4 sigma = +-2 pixels
-            u = 0.5 + 0.5 * ndtri(lo + u * (hi - lo))
-        cam = self.scene.camera
+        u = filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), self.filter)
+        cam = self.camera
         lens = x[:, list(L.pair("lens"))].astype(np.float64) if L.lens else np.zeros((0, 2))
         shutter = x[:, L.index("time")].astype(np.float64) if L.time else np.zeros(0)
         o, d = np.empty((n, 3)), np.empty((n, 3))
         t1 = clock()
-        camera_rays(pixel, np.ascontiguousarray(u), lens, shutter, self.width, self.height, self._tan_x, self._tan_y,
-                    np.ascontiguousarray(self._cam_rot), np.ascontiguousarray(self._cam_pos), float(cam.aperture),
-                    float(cam.focus_distance), np.asarray(cam.motion, dtype=np.float64), o, d)
+        camera_rays(pixel, np.ascontiguousarray(u), lens, shutter, self.width, self.height, cam.tan_x, cam.tan_y,
+                    cam.rot, cam.pos, cam.aperture, cam.focus_distance, cam.motion, o, d)
         t2 = clock()
         tm = self.timings
         tm["camera"] += t2 - t1
@@ -318,9 +281,9 @@ class CompiledIntegrator(reference.Integrator):
                 cols[:2] = L.pair(f"light{depth}")
                 if f"bsdf{depth}.u" in L:
                     cols[2:] = L.pair(f"bsdf{depth}")
-            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self._eps,
+            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self.eps,
                                   self._verts, self._normals, self._areas, self._material, self._emission,
-                                  kinds, colors, alphas, self._em64, self._em_cdf, self._em_prob,
+                                  kinds, colors, alphas, *self._em,
                                   x, *cols, sample_index, rr_key,
                                   lane, o, d, beta, prev_pdf, prev_delta, prim, hit_t, radiance,
                                   sh_o, sh_d, sh_dist, sh_lane, sh_c)
