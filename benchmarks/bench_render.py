@@ -33,8 +33,9 @@ import argparse
 import datetime as _dt
 import json
 import statistics
-import time
 import sys
+import time
+import types
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
@@ -155,18 +156,16 @@ def embree_floor(scene, args, size=(64, 64)) -> dict:
     calls = []
     real_i, real_o = embree.intersect, embree.occluded
 
-    class Recorder:
-        @staticmethod
-        def intersect(sc, fn, width, o, d, prim, t):
-            calls.append(("hit", o.copy(), d.copy(), None))
-            return real_i(sc, fn, width, o, d, prim, t)
+    def intersect(sc, fn, width, o, d, prim, t):
+        calls.append(("hit", o.copy(), d.copy(), None))
+        return real_i(sc, fn, width, o, d, prim, t)
 
-        @staticmethod
-        def occluded(sc, fn, width, o, d, dist, free):
-            calls.append(("occ", o.copy(), d.copy(), dist.copy()))
-            return real_o(sc, fn, width, o, d, dist, free)
+    def occluded(sc, fn, width, o, d, dist, free):
+        calls.append(("occ", o.copy(), d.copy(), dist.copy()))
+        return real_o(sc, fn, width, o, d, dist, free)
 
-    ci.embree = Recorder
+    # the compiled integrator's view of the embree module, with recording queries
+    ci.embree = types.SimpleNamespace(**{**vars(embree), "intersect": intersect, "occluded": occluded})
     try:
         res = render(scene, sampler=args.sampler, spp=args.spp, width=size[0], height=size[1],
                      max_depth=args.max_depth, threads=1, shading="numba")
