@@ -251,27 +251,36 @@ def _load(buf, bits, width, k, o, d, i, tfar):
 
 
 @njit(nogil=True, cache=True)
+def _trace_packet(scene, fn, width, o, d, dist, start, buf, bits, valid):
+    """Load rays ``start ..`` (up to ``width``; ``tfar`` = ``dist`` or inf
+    when ``dist`` is empty) into the packet, mark the rest invalid, and call
+    the query ``fn``. Returns how many lanes hold rays."""
+    m = min(width, o.shape[0] - start)
+    for k in range(width):
+        if k < m:
+            tfar = np.float32(dist[start + k]) if dist.shape[0] > 0 else np.float32(np.inf)
+            _load(buf, bits, width, k, o, d, start + k, tfar)
+            valid[k] = -1
+        else:
+            valid[k] = 0
+    if width == 1:
+        _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+    else:
+        _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+    return m
+
+
+@njit(nogil=True, cache=True)
 def intersect(scene, fn, width, o, d, prim, t):
     """Closest hits of the rays ``o + s d`` (``(n, 3)`` float64, converted to
     float32 like ``embreex``): ``prim[i]`` the triangle (-1 for a miss) and
     ``t[i]`` the distance (inf for a miss). ``fn`` is the address of
     ``rtcIntersect<width>``. Every ray's answer depends on that ray alone."""
-    n = o.shape[0]
     buf, bits = _packet_buffer(width)
-    valid = np.empty(max(width, 1), np.int32)
-    inf = np.float32(np.inf)
-    for start in range(0, n, width):
-        m = min(width, n - start)
-        for k in range(width):
-            if k < m:
-                _load(buf, bits, width, k, o, d, start + k, inf)
-                valid[k] = -1
-            else:
-                valid[k] = 0
-        if width == 1:
-            _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
-        else:
-            _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+    valid = np.empty(width, np.int32)
+    no_dist = np.empty(0)
+    for start in range(0, o.shape[0], width):
+        m = _trace_packet(scene, fn, width, o, d, no_dist, start, buf, bits, valid)
         for k in range(m):
             if bits[GEOM_ID * width + k] == INVALID_ID:
                 prim[start + k] = -1
@@ -284,21 +293,11 @@ def intersect(scene, fn, width, o, d, prim, t):
 @njit(nogil=True, cache=True)
 def occluded(scene, fn, width, o, d, dist, free):
     """``free[i]`` is True where nothing blocks ``o + s d`` for ``0 <= s <=
-    dist[i]`` (float32 as ``embreex``); ``fn`` is ``rtcOccluded<width>``."""
-    n = o.shape[0]
+    dist[i]`` (float32 as ``embreex``); ``fn`` is ``rtcOccluded<width>``.
+    An occluded ray comes back with ``tfar = -inf``."""
     buf, bits = _packet_buffer(width)  # a ray packet is a prefix of a ray-hit packet
-    valid = np.empty(max(width, 1), np.int32)
-    for start in range(0, n, width):
-        m = min(width, n - start)
-        for k in range(width):
-            if k < m:
-                _load(buf, bits, width, k, o, d, start + k, np.float32(dist[start + k]))
-                valid[k] = -1
-            else:
-                valid[k] = 0
-        if width == 1:
-            _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
-        else:
-            _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+    valid = np.empty(width, np.int32)
+    for start in range(0, o.shape[0], width):
+        m = _trace_packet(scene, fn, width, o, d, dist, start, buf, bits, valid)
         for k in range(m):
             free[start + k] = buf[TFAR * width + k] >= 0.0
