@@ -51,9 +51,10 @@ _warned = False
 def _opencl_backend(device: str | None):
     """The (cached) OpenCL backend for a device selector; raises BackendUnavailable."""
     from ._opencl.backend import OpenCLBackend
+    from ._opencl.device import ENV_DEVICE
 
     if device is None:  # the environment's selector, read now: the cache follows it
-        device = os.environ.get("PYOA_OPENCL_DEVICE") or None
+        device = os.environ.get(ENV_DEVICE) or None
     with _lock:
         if device not in _opencl:
             try:
@@ -129,7 +130,7 @@ def backends() -> list[dict]:
         ``backend=None`` picks now) and ``reason`` (why not usable, or None).
         The OpenCL entry also has ``fix`` (what to do when not usable, or
         None) and ``devices``: one dict per OpenCL device, in selector
-        order, with ``selector`` (``"P:D"``), ``description``, ``compiler``
+        order, with ``selector`` (``"P:D"``), ``name``, ``kind``, ``description``, ``compiler``
         (platform, LLVM version and target CPU where known), ``works``
         (bool), ``used`` (bool: the device OpenCL runs on), ``reason`` and
         ``fix`` (one line each, None when it works) and ``log`` (the whole
@@ -151,7 +152,9 @@ def backends() -> list[dict]:
     except RuntimeError:  # no platform, or pyopencl missing: the reason above says so
         statuses = []
     entry["devices"] = [
-        {"selector": st.info.selector, "description": st.info.describe(), "compiler": st.info.compiler(),
+        {"selector": st.info.selector, "name": st.info.device.name.strip(), "kind": st.info.kind,
+         "description": st.info.describe(),
+         "compiler": st.info.compiler(),
          "works": st.works, "used": st.info.device.int_ptr == used, "reason": st.reason, "fix": st.fix,
          "log": st.log}
         for st in statuses

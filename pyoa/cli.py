@@ -143,7 +143,7 @@ def cmd_backends(args) -> int:
             print(f"          fix: {b['fix']}")
         for d in b.get("devices", []):
             verdict = ("works" + (" (used)" if d["used"] else "")) if d["works"] else f"fails: {d['reason']}"
-            print(f"      device {d['selector']} {d['description'].split(' on ')[0]} [{d['compiler']}]: {verdict}")
+            print(f"      device {d['selector']} {d['name']} ({d['kind']}) [{d['compiler']}]: {verdict}")
             if args.verbose and d["log"]:
                 print("        " + "\n        ".join(d["log"].strip().splitlines()))
     print("(* = what backend=None picks; choose with PYOA_BACKEND, PYOA_OPENCL_DEVICE; "

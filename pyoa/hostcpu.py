@@ -58,7 +58,7 @@ def _parse_cpuinfo(text: str) -> HostCPU:
 
     def number(key):
         try:
-            return int(fields[key], 0)
+            return int(fields[key])
         except (KeyError, ValueError):
             return None
 

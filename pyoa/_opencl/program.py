@@ -73,19 +73,23 @@ def first_error(log: str) -> str:
 
 
 @contextlib.contextmanager
-def _stderr_to(path):
-    """Send file descriptor 2 to ``path`` for the duration: PoCL's compiler
-    prints its diagnostics straight to the process's stderr, and a failed
-    build must not flood every user with them (they go into the build log)."""
+def _captured_stderr():
+    """Capture file descriptor 2 for the duration into the yielded list (one
+    string, appended on exit): PoCL's compiler prints its diagnostics straight
+    to the process's stderr, and a failed build must not flood every user with
+    them (they go into the build log)."""
     sys.stderr.flush()
     saved = os.dup(2)
-    try:
-        with open(path, "wb") as fh:
-            os.dup2(fh.fileno(), 2)
-        yield
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
+    printed: list[str] = []
+    with tempfile.TemporaryFile() as fh:
+        os.dup2(fh.fileno(), 2)
+        try:
+            yield printed
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            fh.seek(0)
+            printed.append(fh.read().decode(errors="replace"))
 
 
 def build(info: DeviceInfo, *, text: str | None = None):
@@ -106,22 +110,16 @@ def build(info: DeviceInfo, *, text: str | None = None):
     key = (info.device.int_ptr, text)
     with _lock:
         if key not in _cache:
-            stage = "context"
+            stage, printed = "context", []
             try:
                 ctx = cl.Context([info.device])
                 queue = cl.CommandQueue(ctx)
                 stage = "build"
-                with tempfile.TemporaryDirectory(prefix="pyoa-build-") as tmp:
-                    printed = os.path.join(tmp, "stderr")
-                    try:
-                        with _stderr_to(printed):
-                            prg = cl.Program(ctx, source() if text is None else text).build(
-                                options=BUILD_OPTIONS + defines())
-                    finally:
-                        with open(printed, "rb") as fh:
-                            noise = fh.read().decode(errors="replace")
+                with _captured_stderr() as printed:
+                    prg = cl.Program(ctx, source() if text is None else text).build(options=BUILD_OPTIONS + defines())
             except cl.Error as exc:
-                log = str(exc) + (f"\n(the compiler also printed)\n{noise}" if stage == "build" and noise.strip() else "")
+                noise = "".join(printed)
+                log = str(exc) + (f"\n(the compiler also printed)\n{noise}" if noise.strip() else "")
                 raise BuildError(info, stage, log) from exc
             _cache[key] = (ctx, queue, prg)
         return _cache[key]

@@ -96,15 +96,11 @@ class Integrator:
     """
 
     def __init__(self, scene, layout: Layout, width: int, height: int, filter: str = "box"):
-        from embreex import rtcore_scene as rtcs
-        from embreex.mesh_construction import TriangleMesh
-
         if filter not in FILTERS:
             raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
         self.scene, self.layout = scene, layout
         self.width, self.height, self.filter = width, height, filter
-        self._embree = rtcs.EmbreeScene()
-        TriangleMesh(self._embree, np.ascontiguousarray(scene.triangles, dtype=np.float32))
+        self._tracer = self._build_tracer(scene)
         self.camera = PerspectiveCamera(scene.camera, width, height)
         self.emitters = Emitters(scene)
         #: Rays leave surfaces this far along the normal (Embree has no ray start distance).
@@ -112,13 +108,22 @@ class Integrator:
 
     # -- rays ---------------------------------------------------------------
 
+    def _build_tracer(self, scene):
+        """The scene as ``embreex`` traces it (one Python call per wavefront)."""
+        from embreex import rtcore_scene as rtcs
+        from embreex.mesh_construction import TriangleMesh
+
+        tracer = rtcs.EmbreeScene()
+        TriangleMesh(tracer, np.ascontiguousarray(scene.triangles, dtype=np.float32))
+        return tracer
+
     def _intersect(self, o, d):
-        res = self._embree.run(o.astype(np.float32), d.astype(np.float32), output=1)
+        res = self._tracer.run(o.astype(np.float32), d.astype(np.float32), output=1)
         return res["primID"], res["tfar"].astype(np.float64)
 
     def _visible(self, o, d, dist):
         """True where nothing blocks the segment (Embree: -1 = free)."""
-        occ = self._embree.run(o.astype(np.float32), d.astype(np.float32),
+        occ = self._tracer.run(o.astype(np.float32), d.astype(np.float32),
                                dists=dist.astype(np.float32), query="OCCLUDED")
         return occ == -1
 

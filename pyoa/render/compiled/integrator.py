@@ -133,12 +133,11 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
         mat = material[tri]
         kind, alpha = kinds[mat], alphas[mat]
         cr, cg, cb = colors[mat, 0], colors[mat, 1], colors[mat, 2]
-        row = li
         # next-event estimation: one point on an emitter
         if kind != MIRROR:
             etri, qx, qy, qz, mx, my, mz, pdf_area = sample_emitter(
                 em, em_cdf, em_prob, verts, normals, areas,
-                np.float64(x[row, light_u]), np.float64(x[row, light_v]))
+                np.float64(x[li, light_u]), np.float64(x[li, light_v]))
             vx, vy, vz = qx - px, qy - py, qz - pz
             dist = math.sqrt(vx * vx + vy * vy + vz * vz)
             dn = max(dist, 1e-12)
@@ -169,7 +168,7 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
         if not (mis or depth < max_depth - 1):
             continue
         ix, iy, iz, wr, wg, wb, pdf, delta = sample(kind, cr, cg, cb, alpha, wox, woy, woz,
-                                                    np.float64(x[row, bsdf_u]), np.float64(x[row, bsdf_v]))
+                                                    np.float64(x[li, bsdf_u]), np.float64(x[li, bsdf_v]))
         br, bg, bb = br * wr, bg * wg, bb * wb
         alive = br > 0 or bg > 0 or bb > 0
         if alive and depth >= rr_depth:
@@ -212,16 +211,15 @@ class CompiledIntegrator(reference.Integrator):
     """The path tracer with compiled shading; same constructor and results as
     :class:`pyoa.render.integrator.Integrator` (up to floating-point rounding).
 
-    ``width_packet`` is the Embree packet width (1, 4, 8 or 16; default by
-    CPU, :func:`packet_width`). ``timings`` accumulates the seconds spent per
+    ``packet`` is the Embree packet width (1, 4, 8 or 16; default by CPU,
+    :func:`packet_width`). ``timings`` accumulates the seconds spent per
     stage over every :meth:`radiance` call (``camera``, ``embree``,
     ``shading``, ``host``).
     """
 
     def __init__(self, scene, layout, width, height, filter="box", packet=None):
-        super().__init__(scene, layout, width, height, filter=filter)
         self.packet = packet_width() if packet is None else packet
-        self.rtc = embree.Scene(scene.triangles)
+        super().__init__(scene, layout, width, height, filter=filter)
         self._fn_hit, self._fn_occ = embree.query_addresses(self.packet)
         self._verts = np.ascontiguousarray(scene.triangles, dtype=np.float64)
         m = scene.materials
@@ -235,6 +233,11 @@ class CompiledIntegrator(reference.Integrator):
         self._em = (np.ascontiguousarray(em.index, dtype=np.int64), np.ascontiguousarray(em.cdf),
                     np.ascontiguousarray(em.prob))
         self.timings = {"camera": 0.0, "embree": 0.0, "shading": 0.0, "host": 0.0}
+
+    def _build_tracer(self, scene):
+        """The scene built with Embree's own calls, traced from the compiled loops
+        (the reference's ``embreex`` scene is never built here)."""
+        return embree.Scene(scene.triangles)
 
     def radiance(self, pixel, sample_index, x, seed: int = 0):
         """Radiance (RGB, float64) of the camera paths ``(pixel, sample)`` whose
@@ -273,7 +276,7 @@ class CompiledIntegrator(reference.Integrator):
             if live == 0:
                 break
             t0 = clock()
-            embree.intersect(self.rtc.handle, self._fn_hit, self.packet, o[:live], d[:live], prim, hit_t)
+            embree.intersect(self._tracer.handle, self._fn_hit, self.packet, o[:live], d[:live], prim, hit_t)
             stats.rays += live
             t1 = clock()
             cols = [-1, -1, -1, -1]
@@ -289,7 +292,7 @@ class CompiledIntegrator(reference.Integrator):
                                   sh_o, sh_d, sh_dist, sh_lane, sh_c)
             t2 = clock()
             if shadows:
-                embree.occluded(self.rtc.handle, self._fn_occ, self.packet, sh_o[:shadows], sh_d[:shadows],
+                embree.occluded(self._tracer.handle, self._fn_occ, self.packet, sh_o[:shadows], sh_d[:shadows],
                                 sh_dist[:shadows], free)
                 stats.rays += shadows
             t3 = clock()
