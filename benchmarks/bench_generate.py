@@ -93,14 +93,9 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import hashlib
 import json
-import os
-import platform
-import socket
 import statistics
-import subprocess
 import sys
 import time
 import warnings
@@ -110,13 +105,13 @@ import numpy as np
 
 try:
     import pyoa
-    from pyoa.atomic import atomic_path
 except ImportError as _exc:  # pragma: no cover - environment problem
     sys.exit(f"bench_generate: cannot import pyoa ({_exc}); install it first: pip install -e .")
 
 REPO = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py, shared with bench_render.py
+sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared with bench_render.py
 import peers  # noqa: E402
+from common import loadavg, log, machine, machine_lines, write_text  # noqa: E402
 DEFAULT_OUT = REPO / "benchmarks" / "results" / "generate.json"
 FULL_PIXELS = 65536
 QUICK_PIXELS = 4096
@@ -171,100 +166,7 @@ BACKENDS = ("opencl", "numpy")
 
 
 # ---------------------------------------------------------------------------
-# machine description
-
-
-def _cpu() -> dict:
-    """Vendor, family, model and widest vector ISA: the same workload runs
-    2.5-3.5x faster on the Zen 5 EPYC (AVX-512) than on the AVX2 EPYC of this
-    machine kind, so a figure without its CPU is not comparable."""
-    from pyoa.hostcpu import host_cpu
-
-    cpu = host_cpu()
-    return {"cpu_model": cpu.name, "cpu_vendor": cpu.vendor, "cpu_family": cpu.family,
-            "cpu_model_number": cpu.model, "cpu_isa": cpu.isa, "cpu": cpu.describe()}
-
-
-def _opencl_devices() -> dict:
-    """The OpenCL device pyoa uses by default and every device's status
-    (compiler: platform, LLVM version and target CPU)."""
-    try:
-        from pyoa._opencl.choice import open_device, probe_all
-
-        statuses = probe_all()
-        try:
-            used = open_device()[0].selector
-        except Exception:  # noqa: BLE001 - no device builds: the statuses say why
-            used = None
-    except Exception as exc:  # noqa: BLE001 - no OpenCL at all
-        return {"opencl_default": None, "opencl_devices": [], "opencl_error": f"{type(exc).__name__}: {exc}"}
-    return {
-        "opencl_default": used,
-        "opencl_devices": [{"selector": st.info.selector, "device": st.info.device.name.strip(),
-                            "compiler": st.info.compiler(), "works": st.works, "reason": st.reason}
-                           for st in statuses],
-    }
-
-
-def _git(*args: str) -> str | None:
-    try:
-        res = subprocess.run(["git", "-C", str(REPO), *args], capture_output=True, text=True, timeout=10)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return res.stdout.strip() if res.returncode == 0 else None
-
-
-def _version(module: str) -> str | None:
-    try:
-        from importlib.metadata import version
-
-        return version(module)
-    except Exception:  # noqa: BLE001 - not installed, or no metadata
-        return None
-
-
-def machine() -> dict:
-    commit = _git("rev-parse", "HEAD")
-    status = _git("status", "--porcelain", "--untracked-files=no") if commit else None
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        usable = None
-    return {
-        "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "hostname": socket.gethostname(),
-        **_cpu(),
-        "cpu_count": os.cpu_count(),
-        "cpu_count_usable": usable,
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "pyopencl": _version("pyopencl"),
-        "pocl_binary_distribution": _version("pocl-binary-distribution"),
-        **_opencl_devices(),
-        "pyoa": pyoa.__version__,
-        "pyoa_path": str(Path(pyoa.__file__).resolve().parent),
-        "git_commit": commit,
-        "git_dirty": bool(status) if status is not None else None,
-        "environment": {k: v for k, v in sorted(os.environ.items())
-                        if k.startswith(("PYOA_", "POCL_", "OMP_", "OPENBLAS_", "MKL_"))},
-    }
-
-
-# ---------------------------------------------------------------------------
 # timing
-
-
-def _loadavg() -> list[float] | None:
-    """1, 5 and 15-minute load averages: a load well above 0 before the run means other work competed."""
-    try:
-        return [round(v, 2) for v in os.getloadavg()]
-    except (AttributeError, OSError):
-        return None
-
-
-def _log(msg: str) -> None:
-    print(msg, flush=True)
 
 
 def _digest(x: np.ndarray) -> str:
@@ -282,13 +184,13 @@ def _opencl_details(smp) -> dict:
 
 
 def _line(entry: dict, what: str, dt: float) -> None:
-    _log(f"  {entry['case']:<22} {entry['backend']:<7} {what:<9} {dt:8.3f} s "
+    log(f"  {entry['case']:<22} {entry['backend']:<7} {what:<9} {dt:8.3f} s "
          f"{entry['values'] / dt / 1e6:9.1f} M values/s")
 
 
 def _fail(entry: dict, status: str, exc: Exception) -> None:
     entry.update(status=status, reason=f"{type(exc).__name__}: {exc}")
-    _log(f"  {entry['case']:<22} {entry['backend']:<7} {status.upper()}: {entry['reason']}")
+    log(f"  {entry['case']:<22} {entry['backend']:<7} {status.upper()}: {entry['reason']}")
 
 
 #: Output arrays reused across timed calls, one per shape (see ``--fresh-output``).
@@ -392,10 +294,6 @@ def bench(cases: list[str], backends: list[str], pixels: int, repeats: int, seed
 
 def _m(v: float) -> str:
     return f"{v / 1e6:,.1f}"
-
-
-def _load(avg) -> str:
-    return " / ".join(f"{v:.2f}" for v in avg) if avg else "unknown"
 
 
 def _rate(v: float) -> str:
@@ -518,39 +416,6 @@ def markdown(report: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def machine_lines(meta: dict, total_s: float, devices: dict) -> list[str]:
-    """The "Machine and software" section of a report (shared by the benchmarks)."""
-    commit = meta["git_commit"] or "unknown"
-    if meta["git_dirty"]:
-        commit += " (with uncommitted changes)"
-    lines = [
-        "Machine and software:",
-        "",
-        f"- date (UTC): {meta['date_utc']}; total wall time {total_s:.0f} s",
-        f"- host: {meta['hostname']}; CPU: {meta.get('cpu') or meta['cpu_model']}; cores: {meta['cpu_count']} "
-        f"({meta['cpu_count_usable']} usable); load average (1/5/15 min) {_load(meta['loadavg_start'])} "
-        f"before, {_load(meta['loadavg_end'])} after",
-        f"- Python {meta['python']}, NumPy {meta['numpy']}, pyopencl {meta['pyopencl']}, "
-        f"pyoa {meta['pyoa']} (git {commit})",
-    ]
-    lines += [f"- {name} device: {dev}" for name, dev in devices.items()]
-    for d in meta.get("opencl_devices", []):
-        state = ("works" + (", pyoa's default" if d["selector"] == meta.get("opencl_default") else "")
-                 if d["works"] else f"fails: {d['reason']}")
-        lines.append(f"- OpenCL device {d['selector']}: {d['device']} [{d['compiler']}]: {state}")
-    if meta.get("opencl_error"):
-        lines.append(f"- OpenCL: {meta['opencl_error']}")
-    return lines
-
-
-def _write(path: Path, text: str) -> None:
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-        umask = os.umask(0)
-        os.umask(umask)
-        tmp.chmod(0o666 & ~umask)  # mkstemp creates 0600; results are meant to be shared
-
-
 # ---------------------------------------------------------------------------
 # command line
 
@@ -641,10 +506,10 @@ def main(argv=None) -> int:
 
     t_start = time.perf_counter()
     meta = machine()
-    _log(f"pyoa {meta['pyoa']} (git {meta['git_commit'] or 'unknown'}) on {meta['cpu']}, "
+    log(f"pyoa {meta['pyoa']} (git {meta['git_commit'] or 'unknown'}) on {meta['cpu']}, "
          f"{meta['cpu_count']} cores; {args.pixels:,} pixels, {args.repeats} repeats"
          + (" [QUICK]" if args.quick else ""))
-    load_start = _loadavg()
+    load_start = loadavg()
     rows = list(args.backends)
     if args.opencl_devices == "all" and "opencl" in rows:
         others = [d["selector"] for d in meta["opencl_devices"] if d["works"] and d["selector"] != meta["opencl_default"]]
@@ -657,8 +522,8 @@ def main(argv=None) -> int:
         spec = CASES[REQUIRED_CASE]
         peer_results = peers.run_peers(spec["spp"], spec["dims"], pixels=args.peer_pixels,
                                        budget_s=args.peer_budget, repeats=args.repeats, seed=args.seed,
-                                       full_pixels=FULL_PIXELS, log=_log)
-    meta["loadavg_start"], meta["loadavg_end"] = load_start, _loadavg()
+                                       full_pixels=FULL_PIXELS, log=log)
+    meta["loadavg_start"], meta["loadavg_end"] = load_start, loadavg()
     bits_match = {}
     for case in args.cases:
         digests = {r["digest"] for r in results if r["case"] == case and r.get("digest")}
@@ -685,8 +550,8 @@ def main(argv=None) -> int:
         "total_s": time.perf_counter() - t_start,
     }
     md = markdown(report)
-    _write(out_json, json.dumps(report, indent=2) + "\n")
-    _write(out_md, md)
+    write_text(out_json, json.dumps(report, indent=2) + "\n")
+    write_text(out_md, md)
     print()
     print(md, end="")
     print(f"\nwrote {out_json} and {out_md} ({report['total_s']:.0f} s)")

@@ -1,30 +1,41 @@
 #!/usr/bin/env python3
-"""Render throughput: camera paths and rays per second on a bundled scene.
+"""Render throughput: camera paths and rays per second on the bundled scenes.
 
 What is measured
 ----------------
-``pyoa.render.render.render(scene, sampler=..., spp=..., width=W, height=H,
-max_depth=D)`` (the function behind ``pyoa render``), once as a warm-up on a
-16 x 16 image (kernel build, Embree and import costs), then ``--repeats``
-timed full renders. The time covers sample generation, ray tracing and
-shading, not scene loading or image writing. Reported: median, minimum and
-maximum seconds; camera paths per second and rays per second (camera,
-continuation and shadow rays) at the median.
+For each scene of ``--scenes`` (default: ``cornell``, ``dof7d``, ``bounce9d``
+and ``deep``, each at its own max depth unless ``--max-depth`` is given) and
+each ``--shading`` (numba: compiled shading calling Embree, the default;
+numpy: the reference), ``pyoa.render.render.render(scene, sampler=...,
+spp=..., width=W, height=H)`` (the function behind ``pyoa render``) runs once
+as a warm-up on a 16 x 16 image (kernel build, numba's cache, Embree and
+import costs), then ``--repeats`` timed full renders (``common.timed``). The
+time covers sample generation, ray tracing and shading, not scene loading or
+image writing. Reported: median, minimum and maximum seconds; camera paths
+per second and rays per second (camera, continuation and shadow rays) at the
+median; and a separate single-threaded profile of where the time goes
+(sampling, Embree, each compiled stage, host bookkeeping).
 
-Each ``--shading`` (numba: compiled shading calling Embree, the default;
-numpy: the reference) is timed, with a single-threaded profile of where the
-time goes. If ``mitsuba`` is importable, the same scene is rendered by
-Mitsuba 3's ``orthogonal`` sampler (LLVM backend) in the same run for a
-side-by-side figure; otherwise the report says it was skipped. The Embree
-floor replays a small render's own rays through the shipped tracing path.
+Beside them, in the same run:
+
+- **Mitsuba 3** (``cornell`` only: its own ``cornell_box()`` is the scene's
+  twin), ``orthogonal`` sampler, LLVM backend, path integrator, if
+  ``mitsuba`` is importable; otherwise the report says it was skipped;
+- the **Embree floor**: a 64 x 64 render's own rays replayed through the
+  shipped tracing path (Embree packets called from numba) on two threads,
+  i.e. what the renderer would reach if shading were free;
+- **peak memory** (``--memory``, on by default): a fresh process renders the
+  scene at the full size with each shading and reports its resident-set peak
+  above the warmed-up baseline, beside the bound the renderer states
+  (``pyoa.render.render.working_set_bytes``).
 
 Output: ``benchmarks/results/render.json`` and ``render.md`` (``--out``),
 written atomically.
 
 Usage::
 
-    python benchmarks/bench_render.py                       # cornell 256x256, depth 5, bose 121 spp
-    python benchmarks/bench_render.py --scene dof7d --spp 121 --size 128 128
+    python benchmarks/bench_render.py                        # all four scenes, 256x256, bose 121 spp
+    python benchmarks/bench_render.py --scenes cornell --max-depth 5 --shading numba
 """
 
 from __future__ import annotations
@@ -32,7 +43,9 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import json
+import os
 import statistics
+import subprocess
 import sys
 import time
 import types
@@ -40,15 +53,16 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py, shared with bench_generate.py
+sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared with the other benchmarks
 
 import numpy as np  # noqa: E402
 
 import peers  # noqa: E402
-from bench_generate import _loadavg, machine, machine_lines  # noqa: E402
-from pyoa.atomic import atomic_path  # noqa: E402
-from pyoa.render.render import render  # noqa: E402
+from common import loadavg, log, machine, machine_lines, timed, write_text  # noqa: E402
+from pyoa.render.render import BATCH_PATHS, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
+
+SCENES = ("cornell", "dof7d", "bounce9d", "deep")
 
 
 _MITSUBA = """
@@ -196,81 +210,167 @@ def embree_floor(scene, args, size=(64, 64)) -> dict:
             "rays_per_s": rays / med, "rays_per_path": rays_per_path, "paths_per_s": rays / med / rays_per_path}
 
 
-def time_renders(scene, args, shading: str) -> dict:
-    """Warm-up, then ``--repeats`` timed renders with ``shading``."""
+def _render(scene, args, shading: str, **kw):
     w, h = args.size
-    render(scene, sampler=args.sampler, spp=args.spp, width=16, height=16, max_depth=args.max_depth,
-           shading=shading)
-    runs = []
-    for k in range(args.repeats):
-        res = render(scene, sampler=args.sampler, spp=args.spp, width=w, height=h, max_depth=args.max_depth,
-                     shading=shading)
-        runs.append(res)
-        print(f"{shading} run {k + 1}/{args.repeats}: {res.seconds:.2f} s, {res.paths_per_second / 1e6:.3f} M "
-              f"paths/s, {res.rays_per_second / 1e6:.3f} M rays/s", flush=True)
-    times = [r.seconds for r in runs]
-    med = statistics.median(times)
-    mid = runs[times.index(med)] if med in times else runs[0]
-    return {"shading": shading, "times_s": times, "median_s": med, "min_s": min(times), "max_s": max(times),
-            "paths_per_s": mid.stats.paths / med, "rays_per_s": mid.stats.rays / med,
-            "rays_per_path": mid.stats.rays / mid.stats.paths, "dims": mid.dims,
+    return render(scene, sampler=args.sampler, spp=args.spp, width=kw.pop("width", w), height=kw.pop("height", h),
+                  max_depth=args.max_depth, shading=shading, **kw)
+
+
+def time_renders(scene, args, shading: str) -> dict:
+    """A 16 x 16 warm-up, then ``--repeats`` timed renders with ``shading``
+    (``common.timed``); rates at the median (paths and rays are the same in
+    every run: the image is deterministic)."""
+    _render(scene, args, shading, width=16, height=16)
+    t = timed(lambda: _render(scene, args, shading), args.repeats, warmup=False,
+              label=f"{scene.name} {shading}")
+    res = t.pop("result")
+    med = t["median_s"]
+    log(f"  {scene.name} {shading}: {res.stats.paths / med / 1e6:.3f} M paths/s, "
+        f"{res.stats.rays / med / 1e6:.2f} M rays/s")
+    return {"shading": shading, **t, "paths_per_s": res.stats.paths / med, "rays_per_s": res.stats.rays / med,
+            "rays_per_path": res.stats.rays / res.stats.paths, "dims": res.dims,
             "profile": profile_parts(scene, args, shading)}
 
 
+# ---------------------------------------------------------------------------
+# peak memory, in a fresh process per render
+
+_MEMORY_CHILD = r"""
+import json, sys
+from pyoa.render.render import render
+from pyoa.render.scene import load
+
+def status_kib(key):
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(key + ":"):
+                return int(line.split()[1])
+
+name, sampler, shading = sys.argv[1:4]
+spp, w, h, depth, batch = (int(v) if v != "None" else None for v in sys.argv[4:9])
+scene = load(name)
+# warm-up on one pixel: builds, caches and imports, but no batch-sized heap left behind in the baseline
+render(scene, sampler=sampler, spp=spp, width=1, height=1, max_depth=depth, shading=shading, batch_paths=batch)
+base = status_kib("VmRSS")
+with open("/proc/self/clear_refs", "w") as fh:  # VmHWM := VmRSS (Linux >= 4.0): the peak is the render's own
+    fh.write("5")
+res = render(scene, sampler=sampler, spp=spp, width=w, height=h, max_depth=depth, shading=shading, batch_paths=batch)
+print(json.dumps({"status": "ok", "baseline_kib": base, "peak_kib": status_kib("VmHWM"), "dims": res.dims,
+                  "shading": res.shading}))
+"""
+
+
+def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batch_paths: int) -> dict:
+    """The render's resident-set peak above its warmed-up baseline, in a fresh
+    process, beside the image's own bytes and the batch working set this
+    implies per camera path (``threads x batch_paths`` paths are in flight)."""
+    argv = [scene_name, args.sampler, shading, args.spp, *size, args.max_depth, batch_paths]
+    proc = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, *map(str, argv)], capture_output=True, text=True,
+                          timeout=1800)
+    entry = {"scene": scene_name, "shading": shading, "size": list(size), "batch_paths": batch_paths}
+    if proc.returncode != 0:
+        return {**entry, "status": "failed", "reason": (proc.stderr.strip().splitlines() or ["?"])[-1]}
+    res = json.loads(proc.stdout.strip().splitlines()[-1])
+    threads = os.cpu_count() or 1
+    per_batch = max(1, batch_paths // args.spp) * args.spp  # whole pixels
+    in_flight = min(threads * per_batch, size[0] * size[1] * args.spp)
+    above = (res["peak_kib"] - res["baseline_kib"]) * 1024
+    image = 12 * size[0] * size[1]
+    entry.update(status="ok", threads=threads, baseline_bytes=res["baseline_kib"] * 1024, above_bytes=above,
+                 image_bytes=image, paths_in_flight=in_flight,
+                 bytes_per_path=(above - image) / in_flight)
+    log(f"  memory {scene_name} {shading} {size[0]}x{size[1]} batch {batch_paths}: "
+        f"{above / 2**20:.1f} MiB above baseline ({entry['bytes_per_path']:.0f} B per path in flight)")
+    return entry
+
+
+def memory_rows(scene_names: list[str], args, shadings: list[str]) -> list[dict]:
+    """Peak memory of the full-size render of each scene and shading, and, for
+    the first scene, at twice the width and height (the image grows 4x: the
+    peak must not, beyond the image's own bytes) and at a quarter of the batch
+    (the peak must shrink): the working set is bounded by the batch size."""
+    w, h = args.size
+    rows = []
+    for name in scene_names:
+        for sh in shadings:
+            rows.append(peak_memory(name, args, sh, (w, h), BATCH_PATHS))
+    first = scene_names[0]
+    for sh in shadings:
+        rows.append(peak_memory(first, args, sh, (2 * w, 2 * h), BATCH_PATHS))
+        rows.append(peak_memory(first, args, sh, (w, h), BATCH_PATHS // 4))
+    return rows
+
+
+def bench_scene(name: str, args, shadings: list[str]) -> dict:
+    scene = load(name)
+    log(f"{name}: {args.size[0]} x {args.size[1]}, {args.sampler} {args.spp} spp, max depth "
+        f"{args.max_depth or scene.max_depth}")
+    rows = [time_renders(scene, args, sh) for sh in shadings]
+    w, h = args.size
+    depth = args.max_depth or scene.max_depth
+    mit = mitsuba_figure(name, w, h, args.spp, depth, args.repeats)
+    floor = embree_floor(scene, args) if "numba" in shadings else None
+    return {"scene": name, "max_depth": depth, "results": rows, "mitsuba": mit, "embree_floor": floor}
+
+
+def _csv(text: str, valid: tuple[str, ...], what: str) -> list[str]:
+    items = [v.strip() for v in text.split(",") if v.strip()]
+    bad = [v for v in items if v not in valid]
+    if bad or not items:
+        raise argparse.ArgumentTypeError(f"{what} takes a comma-separated subset of {', '.join(valid)}; got {text!r}")
+    return items
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--scene", default="cornell")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    ap.add_argument("--scenes", type=lambda t: _csv(t, SCENES, "--scenes"), default=list(SCENES),
+                    help=f"comma-separated bundled scenes (default {','.join(SCENES)})")
     ap.add_argument("--sampler", default="bose")
     ap.add_argument("--spp", type=int, default=121)
-    ap.add_argument("--size", type=int, nargs=2, default=(256, 256))
-    ap.add_argument("--max-depth", type=int, default=5)
+    ap.add_argument("--size", type=int, nargs=2, default=(256, 256), metavar=("W", "H"))
+    ap.add_argument("--max-depth", type=int, default=None, help="default: each scene's own")
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--shading", default="numba,numpy",
+    ap.add_argument("--shading", type=lambda t: _csv(t, ("numba", "numpy"), "--shading"), default=["numba", "numpy"],
                     help="comma-separated shadings to time (default numba,numpy)")
+    ap.add_argument("--no-memory", dest="memory", action="store_false", help="skip the peak-memory renders")
     ap.add_argument("--out", default=str(REPO / "benchmarks" / "results" / "render.json"))
     args = ap.parse_args(argv)
-    shadings = [v.strip() for v in args.shading.split(",") if v.strip()]
-    bad = [v for v in shadings if v not in ("numba", "numpy")]
-    if bad or not shadings:
-        ap.error(f"--shading takes numba and/or numpy, got {args.shading!r}")
+    if args.repeats < 1 or args.spp < 1 or min(args.size) < 1:
+        ap.error("--repeats, --spp and --size must be positive")
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    scene = load(args.scene)
-    w, h = args.size
     t_start = time.perf_counter()
     meta = machine()
-    meta["loadavg_start"] = _loadavg()
-    rows = [time_renders(scene, args, sh) for sh in shadings]
-    mit = mitsuba_figure(args.scene, w, h, args.spp, args.max_depth, args.repeats)
-    floor = embree_floor(scene, args) if "numba" in shadings else None
-    meta["loadavg_end"] = _loadavg()
+    log(f"pyoa {meta['pyoa']} (git {meta['git_commit'] or 'unknown'}) on {meta['cpu']}")
+    meta["loadavg_start"] = loadavg()
+    scenes = [bench_scene(name, args, args.shading) for name in args.scenes]
+    memory = memory_rows(args.scenes, args, args.shading) if args.memory else []
+    meta["loadavg_end"] = loadavg()
     report = {
         "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "machine": meta,
-        "config": {"scene": args.scene, "sampler": args.sampler, "spp": args.spp, "size": [w, h],
-                   "max_depth": args.max_depth, "repeats": args.repeats, "shadings": shadings},
-        "results": rows, "mitsuba": mit, "embree_floor": floor,
+        "config": {"scenes": args.scenes, "sampler": args.sampler, "spp": args.spp, "size": list(args.size),
+                   "max_depth": args.max_depth, "repeats": args.repeats, "shadings": args.shading,
+                   "batch_paths": BATCH_PATHS},
+        "scenes": scenes, "memory": memory,
     }
-    with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(report, indent=2) + "\n")
+    write_text(out, json.dumps(report, indent=2) + "\n")
     md = markdown(report, time.perf_counter() - t_start)
-    with atomic_path(out.with_suffix(".md")) as tmp:
-        tmp.write_text(md)
+    write_text(out.with_suffix(".md"), md)
     print(md)
     return 0
 
 
-def markdown(report: dict, total_s: float) -> str:
-    cfg, mit, floor = report["config"], report["mitsuba"], report["embree_floor"]
+def scene_markdown(cfg: dict, sc: dict) -> list[str]:
+    mit, floor = sc["mitsuba"], sc["embree_floor"]
     w, h = cfg["size"]
     mit_rate = mit.get("paths_per_s") if mit["status"] == "ok" else None
-    lines = ["# pyoa render benchmark", "",
-             f"`{cfg['scene']}` {w} x {h}, max depth {cfg['max_depth']}, {cfg['sampler']} {cfg['spp']} spp "
-             f"({report['results'][0]['dims']} dims), {cfg['repeats']} runs after a warm-up, all CPUs, "
-             f"{report['date_utc']}. Mitsuba and the Embree floor in the same run.", "",
+    lines = [f"## `{sc['scene']}`", "",
+             f"{w} x {h}, max depth {sc['max_depth']}, {cfg['sampler']} {cfg['spp']} spp "
+             f"({sc['results'][0]['dims']} dims), {cfg['repeats']} runs after a warm-up, all CPUs.", "",
              "| renderer | median s | min s | max s | M paths/s | M rays/s | rays/path | / Mitsuba |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
-    for r in report["results"]:
+    for r in sc["results"]:
         ratio = f"{r['paths_per_s'] / mit_rate:.2f}x" if mit_rate else ""
         lines.append(f"| pyoa, {r['shading']} shading | {r['median_s']:.2f} | {r['min_s']:.2f} | {r['max_s']:.2f} | "
                      f"{r['paths_per_s'] / 1e6:.3f} | {r['rays_per_s'] / 1e6:.2f} | {r['rays_per_path']:.2f} | {ratio} |")
@@ -281,7 +381,7 @@ def markdown(report: dict, total_s: float) -> str:
     else:
         lines.append(f"| Mitsuba | {mit['status']}: {mit.get('reason')} | | | | | | |")
     if floor:
-        numba = next((r for r in report["results"] if r["shading"] == "numba"), None)
+        numba = next((r for r in sc["results"] if r["shading"] == "numba"), None)
         share = f"; the numba renderer reaches {numba['paths_per_s'] / floor['paths_per_s']:.0%} of it" if numba else ""
         ratio = f" = {floor['paths_per_s'] / mit_rate:.2f}x Mitsuba" if mit_rate else ""
         lines += ["", f"Embree floor (the rays of a {floor['size'][0]} x {floor['size'][1]} render of the same "
@@ -289,13 +389,48 @@ def markdown(report: dict, total_s: float) -> str:
                       f"{floor['threads']} threads): {floor['rays_per_s'] / 1e6:.2f} M rays/s = "
                       f"{floor['paths_per_s'] / 1e6:.3f} M paths/s at {floor['rays_per_path']:.2f} rays/path"
                       f"{ratio}{share}."]
-    for r in report["results"]:
-        prof = r["profile"]
-        lines += ["", f"Where the time goes, {r['shading']} shading (a separate render on 1 thread: "
-                      f"{prof['seconds']:.2f} s, {prof['paths_per_s'] / 1e6:.3f} M paths/s):", "",
-                  "| part | s | share |", "|---|---:|---:|"]
-        lines += [f"| {k} | {v:.2f} | {100 * prof['shares'][k]:.0f} % |" for k, v in prof["parts_s"].items()]
-    lines += ["", *machine_lines(report["machine"], total_s, {})]
+    profs = [r for r in sc["results"]]
+    parts = list(dict.fromkeys(k for r in profs for k in r["profile"]["parts_s"]))
+    lines += ["", "Where the time goes (a separate render on 1 thread; seconds and share of it):", "",
+              "| part | " + " | ".join(f"{r['shading']}" for r in profs) + " |",
+              "|---|" + "---:|" * len(profs)]
+    for k in parts:
+        cells = [(f"{r['profile']['parts_s'][k]:.2f} s ({100 * r['profile']['shares'][k]:.0f} %)"
+                  if k in r["profile"]["parts_s"] else "") for r in profs]
+        lines.append(f"| {k} | " + " | ".join(cells) + " |")
+    lines.append("| **total** (M paths/s) | " + " | ".join(
+        f"{r['profile']['seconds']:.2f} s ({r['profile']['paths_per_s'] / 1e6:.3f})" for r in profs) + " |")
+    return lines
+
+
+def memory_markdown(rows: list[dict]) -> list[str]:
+    lines = ["## Peak memory", "",
+             "Resident-set peak of the render above the warmed-up process (a fresh process per row; "
+             "`/proc/self/status` VmHWM after resetting it), the image's own bytes (float32 RGB) and the rest per "
+             "camera path in flight (threads x batch paths):", "",
+             "| scene | shading | size | batch paths | paths in flight | peak above baseline | image | per path in flight |",
+             "|---|---|---|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        if r["status"] != "ok":
+            lines.append(f"| {r['scene']} | {r['shading']} | {r['size'][0]} x {r['size'][1]} | {r['batch_paths']:,} | "
+                         f"failed: {r['reason']} | | | |")
+            continue
+        lines.append(f"| {r['scene']} | {r['shading']} | {r['size'][0]} x {r['size'][1]} | {r['batch_paths']:,} | "
+                     f"{r['paths_in_flight']:,} | {r['above_bytes'] / 2**20:.1f} MiB | {r['image_bytes'] / 2**20:.2f} MiB "
+                     f"| {r['bytes_per_path']:,.0f} B |")
+    return lines
+
+
+def markdown(report: dict, total_s: float) -> str:
+    cfg = report["config"]
+    lines = ["# pyoa render benchmark", "",
+             f"{report['date_utc']}; CPU: {report['machine'].get('cpu')}. Mitsuba and the Embree floor in the same run; "
+             "ratios compare rows of this run only (this machine kind drifts 15-40 % between processes).", ""]
+    for sc in report["scenes"]:
+        lines += [*scene_markdown(cfg, sc), ""]
+    if report["memory"]:
+        lines += [*memory_markdown(report["memory"]), ""]
+    lines += machine_lines(report["machine"], total_s, {})
     return "\n".join(lines) + "\n"
 
 

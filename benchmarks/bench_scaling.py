@@ -73,7 +73,7 @@ per-call overhead (validation, launch, allocation), not the kernels.
 Output
 ------
 ``benchmarks/results/scaling.json`` (``--out`` to change the stem) with every
-run's time and the machine's description (``bench_generate.machine()``),
+run's time and the machine's description (``common.machine()``),
 ``scaling.md`` beside it, and the figures ``scaling-spp.png``,
 ``scaling-dims.png``, ``scaling-pixels.png`` and ``render-size.png`` in
 ``docs/performance/`` (``--figures``). ``--quick`` divides the sizes (2e6
@@ -117,14 +117,10 @@ from bench_generate import (  # noqa: E402  (benchmarks/ is on sys.path above)
     _digest,
     _fail,
     _line,
-    _loadavg,
-    _log,
     _opencl_details,
-    _write,
-    machine,
-    machine_lines,
     summarize,
 )
+from common import loadavg, log, machine, machine_lines, write_text  # noqa: E402
 
 try:
     import pyoa
@@ -190,7 +186,7 @@ def prepare(point: dict, backend: str, seed: int, max_values: float) -> tuple[di
     entry = _entry(point, backend)
     if point["values"] > max_values:
         entry.update(status="skipped", reason=f"{point['values']:,} values is over --max-values {max_values:,.0f}")
-        _log(f"  {entry['case']:<22} {backend:<7} SKIPPED: {entry['reason']}")
+        log(f"  {entry['case']:<22} {backend:<7} SKIPPED: {entry['reason']}")
         return entry, None
     try:
         with warnings.catch_warnings():
@@ -217,7 +213,7 @@ def prepare(point: dict, backend: str, seed: int, max_values: float) -> tuple[di
 
 def run_sweep(sweep: str, backends: list[str], args) -> list[dict]:
     """Warm up every (point, backend) of ``sweep``, then time them round-robin, ``repeats`` rounds."""
-    _log(f"sweep {sweep}:")
+    log(f"sweep {sweep}:")
     pairs = [prepare(p, b, args.seed, args.max_values)
              for p in sweep_points(sweep, args.target_values, args.quick) for b in backends]
     for k in range(args.repeats):
@@ -309,11 +305,11 @@ def _bound(backend: str, child: dict, spp: int, dims: int, pixels: int) -> dict:
 def measure_memory(backends: list[str], args) -> list[dict]:
     pts = [p for p in sweep_points("pixels", args.target_values, args.quick) if p["values"] <= args.max_values]
     if not pts:
-        _log("memory: every pixels point is over --max-values; skipped")
+        log("memory: every pixels point is over --max-values; skipped")
         return [{"backend": b, "status": "skipped", "reason": "every pixels point is over --max-values"}
                 for b in backends]
     p = max(pts, key=lambda q: q["values"])
-    _log(f"memory: {p['pixels']:,} pixels x {p['spp']} spp x {p['dims']} dims, fresh process per backend")
+    log(f"memory: {p['pixels']:,} pixels x {p['spp']} spp x {p['dims']} dims, fresh process per backend")
     out = []
     for b in backends:
         entry = {"backend": b, "spp": p["spp"], "dims": p["dims"], "pixels": p["pixels"], "values": p["values"]}
@@ -322,7 +318,7 @@ def measure_memory(backends: list[str], args) -> list[dict]:
         if proc.returncode != 0:
             tail = (proc.stderr or proc.stdout).strip().splitlines()
             entry.update(status="failed", reason=f"exit {proc.returncode}: {tail[-1] if tail else ''}"[:300])
-            _log(f"  {b:<7} FAILED: {entry['reason']}")
+            log(f"  {b:<7} FAILED: {entry['reason']}")
             out.append(entry)
             continue
         child = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -341,7 +337,7 @@ def measure_memory(backends: list[str], args) -> list[dict]:
         bound = _bound(b, child, p["spp"], p["dims"], p["pixels"])
         entry.update(peak_minus_baseline_bytes=grown, working_set_bytes=working, bound=bound,
                      under_bound=working <= bound["bytes"])
-        _log(f"  {b:<7} baseline {base / 1024:8.1f} MiB  peak {entry['peak_kib'] / 1024:8.1f} MiB  "
+        log(f"  {b:<7} baseline {base / 1024:8.1f} MiB  peak {entry['peak_kib'] / 1024:8.1f} MiB  "
              f"output {child['output_bytes'] / MiB:8.1f} MiB  working set beyond output {working / MiB:7.1f} MiB  "
              f"bound {bound['bytes'] / MiB:7.1f} MiB: {'under' if entry['under_bound'] else 'OVER'}")
         out.append(entry)
@@ -357,7 +353,7 @@ def run_render(args) -> dict:
     from pyoa.render.scene import load
 
     spp, sizes = args.render_spp, args.render_sizes
-    _log(f"render: {RENDER_SCENE}, {SAMPLER} {spp} spp, max depth {args.max_depth}, sizes {sizes}")
+    log(f"render: {RENDER_SCENE}, {SAMPLER} {spp} spp, max depth {args.max_depth}, sizes {sizes}")
     info = {"scene": RENDER_SCENE, "sampler": SAMPLER, "spp": spp, "max_depth": args.max_depth,
             "backend": args.render_backend or "auto", "results": []}
     try:
@@ -371,7 +367,7 @@ def run_render(args) -> dict:
             info["backend"] = f"auto ({auto.backend})"
     except Exception as exc:  # noqa: BLE001 - reported, the generate sweeps still count
         info.update(status="failed", reason=f"{type(exc).__name__}: {exc}")
-        _log(f"  render FAILED: {info['reason']}")
+        log(f"  render FAILED: {info['reason']}")
         return info
     rows = [{"size": [s, s], "paths": s * s * spp, "times_s": [], "rays": None} for s in sizes]
     for k in range(args.repeats):
@@ -381,7 +377,7 @@ def run_render(args) -> dict:
                          backend=args.render_backend)
             row["times_s"].append(res.seconds)
             row["rays"] = res.stats.rays  # the same for every run (fixed seed)
-            _log(f"  {w}x{h:<14} run {k + 1}/{args.repeats} {res.seconds:8.3f} s "
+            log(f"  {w}x{h:<14} run {k + 1}/{args.repeats} {res.seconds:8.3f} s "
                  f"{row['paths'] / res.seconds / 1e6:9.3f} M paths/s")
     for row in rows:
         t = row["times_s"]
@@ -663,15 +659,15 @@ def main(argv=None) -> int:
 
     t_start = time.perf_counter()
     meta = machine()
-    _log(f"pyoa {meta['pyoa']} (git {meta['git_commit'] or 'unknown'}) on {meta['cpu_model']}, "
+    log(f"pyoa {meta['pyoa']} (git {meta['git_commit'] or 'unknown'}) on {meta['cpu_model']}, "
          f"{meta['cpu_count']} cores; parts {','.join(args.sweeps)}, {args.repeats} repeats"
          + (" [QUICK]" if args.quick else ""))
-    load_start = _loadavg()
+    load_start = loadavg()
     # memory first: the children then start from a small parent (see measure_memory)
     memory = measure_memory(args.backends, args) if "memory" in args.sweeps else None
     sweeps = {s: run_sweep(s, args.backends, args) for s in SWEEPS if s in args.sweeps}
     rnd = run_render(args) if "render" in args.sweeps else None
-    meta["loadavg_start"], meta["loadavg_end"] = load_start, _loadavg()
+    meta["loadavg_start"], meta["loadavg_end"] = load_start, loadavg()
 
     bits_match = {}
     for s, rows in sweeps.items():
@@ -702,8 +698,8 @@ def main(argv=None) -> int:
     written = figures(report, args.figures)
     report["figures"] = [str(p.relative_to(REPO)) if p.is_relative_to(REPO) else str(p) for p in written]
     md = markdown(report)
-    _write(out_json, json.dumps(report, indent=2) + "\n")
-    _write(out_md, md)
+    write_text(out_json, json.dumps(report, indent=2) + "\n")
+    write_text(out_md, md)
     print()
     print(md, end="")
     print(f"\nwrote {out_json}, {out_md} and {len(written)} figure(s) in {args.figures} "
