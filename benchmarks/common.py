@@ -15,7 +15,6 @@ from __future__ import annotations
 import datetime as _dt
 import os
 import platform
-import resource
 import socket
 import statistics
 import subprocess
@@ -148,10 +147,6 @@ def timed(fn: Callable[[], object], repeats: int, *, warmup: bool = True, label:
     return {"times_s": times, "median_s": statistics.median(times), "min_s": min(times), "max_s": max(times),
             "result": result}
 
-
-def maxrss_bytes() -> int:
-    """This process's peak resident set size so far (Linux reports KiB)."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 # ---------------------------------------------------------------------------
