@@ -85,15 +85,29 @@ def _int(name: str, value, lo: int | None = None, hi: int | None = None) -> int:
 def _points(points, what: str = "points", closed: bool = False) -> np.ndarray:
     """``points`` as a real array of shape (..., N, d) with every value in [0, 1)
     (or [0, 1] when ``closed``); float32 stays float32, the rest becomes float64."""
-    x = np.asarray(points)
-    if x.dtype == bool or not (np.issubdtype(x.dtype, np.floating) or np.issubdtype(x.dtype, np.integer)):
-        raise ValueError(f"{what} must be a real array, got dtype {x.dtype}")
+    x = _unit_values(points, what, closed)
     if x.ndim < 2:
         raise ValueError(f"{what} must have shape (N, d) (or (..., N, d)), got shape {x.shape}")
     if x.shape[-2] == 0 or x.shape[-1] == 0:
         raise ValueError(f"{what} must hold at least one point of at least one dimension, got shape {x.shape}")
+    return x
+
+
+def _unit_values(values, what: str, closed: bool = False) -> np.ndarray:
+    """``values`` (any shape) as a real array with every value finite and in
+    [0, 1) (or [0, 1] when ``closed``); float32 stays float32, the rest
+    becomes float64."""
+    try:
+        x = np.asarray(values)
+    except ValueError:  # ragged nested sequences
+        raise ValueError(f"{what} must be a real array (a regular, not ragged, nested sequence)") from None
+    # "m" (timedelta64) counts as an integer subtype to NumPy
+    if x.dtype.kind not in "iuf":
+        raise ValueError(f"{what} must be a real array, got dtype {x.dtype}")
     if x.dtype not in (np.float32, np.float64):
         x = x.astype(np.float64)
+    if x.size == 0:
+        return x
     if not np.all(np.isfinite(x)):
         raise ValueError(f"{what} must be finite (found NaN or infinity)")
     lo, hi = float(x.min()), float(x.max())
@@ -119,6 +133,12 @@ def cells(x, s: int) -> np.ndarray:
         ``k`` with ``k/s <= x < (k+1)/s`` for the value ``x`` as stored (no
         tolerance: a value on a cell edge belongs to the cell above it).
 
+    Raises
+    ------
+    ValueError
+        Values that are not real numbers, not finite (NaN has no cell), or
+        outside ``[0, 1)``, as for the other functions of this module.
+
     Notes
     -----
     A float32 value times an integer ``s <= 2**24`` is exact in float64 (24 +
@@ -140,8 +160,12 @@ def cells(x, s: int) -> np.ndarray:
        available precision", Numerische Mathematik 18 (1971), 224-242.
     """
     s = _int("s", s, 1, 2**24)
-    x = np.asarray(x)
-    if x.dtype == np.float32 or np.issubdtype(x.dtype, np.integer):
+    return _cells(_unit_values(x, "x"), s)
+
+
+def _cells(x: np.ndarray, s: int) -> np.ndarray:
+    """:func:`cells` of values already checked (finite, in [0, 1), float32 or float64)."""
+    if x.dtype == np.float32:
         return np.floor(x.astype(np.float64) * s).astype(np.int64)
     x = x.astype(np.float64)
     p = x * s
@@ -295,7 +319,7 @@ def stratification(points, s: int, t: int, *, dims: Iterable[int] | None = None)
                          f"s^t must divide N")
     sets = x.reshape(-1, N, d)
     n_sets = len(sets)
-    k = cells(sets[:, :, list(dims)], s)  # (n_sets, N, len(dims)), only the dims checked
+    k = _cells(sets[:, :, list(dims)], s)  # (n_sets, N, len(dims)), only the dims checked
     base = (np.arange(n_sets, dtype=np.int64) * n_cells)[:, None]
     failing, worst = [], 0
     for sub in itertools.combinations(range(len(dims)), t):

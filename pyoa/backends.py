@@ -71,8 +71,20 @@ def _opencl_backend(device: str | None):
 
 
 def choose(backend: str | None = None, device: str | None = None):
-    """Return the backend object for ``backend`` (see the module docstring)."""
+    """Return the backend object for ``backend`` (see the module docstring).
+
+    Raises
+    ------
+    TypeError
+        A ``backend`` or ``device`` that is not a str or None.
+    ValueError
+        An unknown backend name, an empty device selector, or one that
+        matches no OpenCL device.
+    BackendUnavailable
+        ``"opencl"`` named explicitly but not usable.
+    """
     global _warned
+    _check_selector(device)
     if backend is None:
         backend = os.environ.get(ENV_BACKEND) or None
         origin = f"${ENV_BACKEND}"
@@ -96,6 +108,19 @@ def choose(backend: str | None = None, device: str | None = None):
         if first:
             warnings.warn(fallback_message(exc), PyoaFallbackWarning, stacklevel=_first_frame_outside_pyoa())
         return NumpyBackend()
+
+
+def _check_selector(device) -> None:
+    """Refuse a device selector that is not a str (or None) whichever backend
+    is chosen: ``device=0`` is not an index, it would only fail later or
+    nowhere (see :mod:`pyoa._opencl.device` for the forms)."""
+    if device is not None and not isinstance(device, str):
+        raise TypeError(f"device must be an OpenCL device selector string ('P:D' such as '0:1', 'P' such as "
+                        f"'0', 'gpu', 'cpu' or part of a device name) or None, got {type(device).__name__} "
+                        f"{device!r}")
+    if isinstance(device, str) and not device.strip():
+        raise ValueError("device must not be empty; valid: 'P:D', 'P', 'gpu', 'cpu', 'accelerator' or part "
+                         "of a device name (list: pyoa backends), or None for the default")
 
 
 def _first_frame_outside_pyoa() -> int:

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 import warnings
@@ -18,11 +19,32 @@ import warnings
 import numpy as np
 
 from . import OFFSETS, backends, sampler, samplers, valid_spp
-from .atomic import atomic_path
+from .atomic import atomic_path, check_writable
 from .backends import BackendUnavailable, PyoaFallbackWarning
-from .constructions import get
+from .constructions import MAX_UINT32, check_int, get
 
 FORMATS = (".npy", ".csv")
+#: Values per block of CSV rows written at once (bounds the float64 table).
+CSV_BLOCK_VALUES = 1 << 22
+
+
+def _suffix(path: str) -> str:
+    """The lower-case extension of ``path`` (``""`` when it has none)."""
+    name = os.path.basename(str(path))
+    return name[name.rfind("."):].lower() if "." in name else ""
+
+
+def check_out(path: str, formats: tuple[str, ...], what: str = "--out") -> None:
+    """Refuse, before any work, an output whose extension is not one of
+    ``formats`` (what is written there) or that cannot be written."""
+    if _suffix(path) not in formats:
+        raise ValueError(f"{what} must end in {' or '.join(formats)}, got {str(path)!r}")
+    check_writable(path)
+
+
+def _option(args, name: str, lo: int | None = None, hi: int | None = None) -> int:
+    """Command-line option ``--name`` checked as an int in ``[lo, hi]``."""
+    return check_int(f"--{name.replace('_', '-')}", getattr(args, name), lo, hi)
 
 
 def save_points(x: np.ndarray, path: str, pixels: range) -> None:
@@ -31,7 +53,7 @@ def save_points(x: np.ndarray, path: str, pixels: range) -> None:
     The CSV has one row per (pixel, sample): ``pixel,sample,x0,...`` with
     values printed with 9 significant digits, enough to round-trip float32.
     """
-    suffix = path[path.rfind("."):].lower() if "." in path else ""
+    suffix = _suffix(path)
     if suffix not in FORMATS:
         raise ValueError(f"--out must end in {' or '.join(FORMATS)}, got {path!r}")
     with atomic_path(path) as tmp:
@@ -39,12 +61,18 @@ def save_points(x: np.ndarray, path: str, pixels: range) -> None:
             np.save(tmp, x)
         else:
             n_p, n_s, n_d = x.shape
-            pix = np.repeat(np.asarray(pixels, dtype=np.int64), n_s)
-            smp = np.tile(np.arange(n_s), n_p)
             with open(tmp, "w") as fh:
                 fh.write(",".join(["pixel", "sample"] + [f"x{d}" for d in range(n_d)]) + "\n")
                 fmt = "%d,%d" + ",%.9g" * n_d
-                np.savetxt(fh, np.column_stack([pix, smp, x.reshape(n_p * n_s, n_d).astype(np.float64)]), fmt=fmt)
+                # A block of pixels at a time: the float64 table of the whole
+                # array would need 2.5 times the memory generate was allowed.
+                step = max(1, CSV_BLOCK_VALUES // (n_s * (n_d + 2)))
+                for a in range(0, n_p, step):
+                    b = min(a + step, n_p)
+                    pix = np.repeat(np.asarray(pixels[a:b], dtype=np.int64), n_s)
+                    smp = np.tile(np.arange(n_s), b - a)
+                    table = np.column_stack([pix, smp, x[a:b].reshape((b - a) * n_s, n_d).astype(np.float64)])
+                    np.savetxt(fh, table, fmt=fmt)
 
 
 def _rate(per_s: float) -> str:
@@ -55,10 +83,21 @@ def _rate(per_s: float) -> str:
     return f"{per_s:.3g}"
 
 
+def _pixel_range(args) -> range:
+    """``--pixel0`` and ``--pixels`` as the range of pixels (at least one, all uint32)."""
+    pixel0 = _option(args, "pixel0", 0, MAX_UINT32)
+    count = _option(args, "pixels", 1)
+    if pixel0 + count > MAX_UINT32 + 1:
+        raise ValueError(f"--pixels {count} from --pixel0 {pixel0} runs past the last pixel index {MAX_UINT32} "
+                         f"(pixels are uint32); at most {MAX_UINT32 + 1 - pixel0} from there")
+    return range(pixel0, pixel0 + count)
+
+
 def cmd_points(args) -> int:
+    pixels = _pixel_range(args)
+    check_out(args.out, FORMATS)
     smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, offset=args.offset,
                   jitter=args.jitter, strength=args.strength, backend=args.backend, device=args.device)
-    pixels = range(args.pixel0, args.pixel0 + args.pixels)
     t0 = time.perf_counter()
     x = smp.generate(pixels=pixels, progress=not args.quiet)
     dt = time.perf_counter() - t0
@@ -79,6 +118,8 @@ def cmd_samplers(args) -> int:
 
 
 def cmd_spp(args) -> int:
+    _option(args, "limit", 1)
+    # valid_spp refuses --near, --dims and --strength values the sampler cannot have
     choices = valid_spp(args.sampler, near=args.near, dims=args.dims, strength=args.strength)
     if get(args.sampler).family == "oa":
         print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
@@ -235,7 +276,9 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning
             return args.func(args)
-    except (ValueError, TypeError, FileNotFoundError, BackendUnavailable) as exc:
+    except (ValueError, TypeError, OSError, BackendUnavailable) as exc:
+        # OSError: an output that cannot be written (pyoa.atomic names the
+        # user's path), a missing input file; a one-line message, not a traceback
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
 
 

@@ -23,6 +23,9 @@ from __future__ import annotations
 import importlib
 import itertools
 import math
+import numbers
+import operator
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import NamedTuple
@@ -40,6 +43,18 @@ MAX_SPP = 2**24
 MAX_DIMS = 2**20
 #: Largest user seed, pixel index: both are uint32 (SPEC section 3).
 MAX_UINT32 = 2**32 - 1
+
+
+def check_int(name: str, value, lo: int | None = None, hi: int | None = None) -> int:
+    """``value`` as a Python int in ``[lo, hi]``; bools and floats are refused
+    (TypeError), out-of-range values too (ValueError), each naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
+    value = int(value)
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        rng = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
+        raise ValueError(f"{name} must be {rng}, got {value}")
+    return value
 
 
 class SppChoice(NamedTuple):
@@ -91,6 +106,30 @@ class Params:
     block_dims: int
     M: int
     dims: int = 0
+
+
+class _Counts(Sequence):
+    """The choices for every count ``first .. last``, made on demand (a list
+    of all 16.7 million would take gigabytes and seconds)."""
+
+    def __init__(self, first: int, last: int, make):
+        self._first, self._len, self._make = first, last - first + 1, make
+
+    def __len__(self):
+        return self._len
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self._make(self._first + i) for i in range(*k.indices(self._len))]
+        k = operator.index(k)
+        if k < 0:
+            k += self._len
+        if not 0 <= k < self._len:
+            raise IndexError(k)
+        return self._make(self._first + k)
+
+    def __eq__(self, other):
+        return isinstance(other, Sequence) and len(other) == self._len and all(a == b for a, b in zip(self, other))
 
 
 def is_prime(n: int) -> bool:
@@ -167,6 +206,14 @@ class Construction:
     #: whether the integer array is computed in a Galois field (the backends
     #: then need pyoa.gf's tables for prime-power orders); see field_order
     uses_field = False
+
+    def __setattr__(self, key, value):
+        # One shared instance per sampler name serves every Sampler: changing
+        # it would change every sampler of the process.
+        raise AttributeError(f"cannot set {key!r}: the catalogue's constructions are immutable")
+
+    def __delattr__(self, key):
+        raise AttributeError(f"cannot delete {key!r}: the catalogue's constructions are immutable")
 
     def field_order(self, params: Params) -> int:
         """Order of the field the array is computed in (0: none)."""
@@ -325,8 +372,11 @@ class CMJND(Construction):
                                          lambda s, t: s >= 2, lambda s, t: t), spp)
 
     def choices(self, dims=None, strength=None):
+        strengths = self._strengths(dims, strength)
+        if strengths == [1]:  # every count 2 .. 2**24: listed lazily, not as 16.7 million tuples
+            return _Counts(2, MAX_SPP, lambda n: SppChoice(n, n, 1, 1))
         out = []
-        for t in self._strengths(dims, strength):
+        for t in strengths:
             s = 2
             while s**t <= MAX_SPP:
                 out.append(SppChoice(s**t, s, t, t))
@@ -485,11 +535,30 @@ def valid_spp(name: str, near: int | None = None, dims: int | None = None, stren
     Examples
     --------
     >>> [c.label() for c in valid_spp("bose", near=120)]
-    ['121 (s=11)', '169 (s=13)']
+    ['81 (s=9)', '121 (s=11)']
     >>> [c.label() for c in valid_spp("sobol", near=120)]
     ['64 (2^6)', '128 (2^7)']
+
+    Raises
+    ------
+    ValueError
+        An unknown sampler; a negative ``near``; ``dims`` outside
+        ``[1, 2**20]``; a ``strength`` the sampler does not have (as
+        :func:`pyoa.sampler` refuses it: ``bose`` has strength 2 only,
+        ``bush`` 2..8...), rather than an empty list.
+    TypeError
+        A name that is not a str, or a count that is not an int.
     """
     construction = get(name)
+    near = None if near is None else check_int("near", near, 0)
+    dims = None if dims is None else check_int("dims", dims, 1, MAX_DIMS)
+    strength = None if strength is None else check_int("strength", strength, 1)
+    construction.solve(1, dims, strength)  # raises for a strength (or dims) this sampler cannot have
+    return _listing(construction, near, dims, strength)
+
+
+def _listing(construction: Construction, near: int | None, dims: int | None, strength: int | None):
+    """:func:`valid_spp` of arguments already checked (or to be taken as they are)."""
     if near is None:
         return construction.choices(dims=dims, strength=strength)
     return construction.nearest(int(near), dims=dims, strength=strength)
@@ -501,5 +570,7 @@ def nearest_spp(name: str, spp: int, dims: int | None = None, strength: int | No
     ``dims`` and ``strength``. Used wherever a requested count is replaced by
     a sampler's nearest one (``pyoa compare``, convergence studies, the qmc
     engine's default)."""
-    choices = valid_spp(name, near=spp, dims=dims, strength=strength)
+    # Unlike valid_spp, a strength the sampler cannot have means "none" here
+    # (convergence studies skip such a sampler instead of failing).
+    choices = _listing(get(name), spp, dims, strength)
     return min((c.spp for c in choices), key=lambda n: (abs(n - spp), n)) if choices else None

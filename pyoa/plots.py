@@ -16,15 +16,31 @@ References
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import numpy as np
 
-from .atomic import atomic_path
+from .atomic import atomic_path, check_writable
+from .constructions import MAX_UINT32, check_int
 from .samplers import sampler as make_sampler
 
 #: Largest number of dimensions in a projection matrix (D*(D-1)/2 panels).
 MAX_PLOT_DIMS = 16
+#: Figure sizes accepted, in pixels.
+MIN_SIZE, MAX_SIZE = 64, 8192
+
+
+def _check_figure(out, size) -> None:
+    """Refuse, before any sampling, a figure that cannot be written: ``out``
+    must end in .png (the figure is written as PNG, whatever the name says)
+    and be writable, ``size`` an int in [64, 8192]."""
+    if isinstance(size, bool) or not isinstance(size, int) or not MIN_SIZE <= size <= MAX_SIZE:
+        raise ValueError(f"figure size must be an integer in [{MIN_SIZE}, {MAX_SIZE}] pixels, got {size!r}")
+    name = os.path.basename(str(out))
+    if not name.lower().endswith(".png") or name.lower() == ".png":
+        raise ValueError(f"out must end in .png (the figure is written as PNG), got {str(out)!r}")
+    check_writable(out)
 
 
 def _figure(size: int, height: int | None = None):
@@ -33,8 +49,6 @@ def _figure(size: int, height: int | None = None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    if isinstance(size, bool) or not isinstance(size, int) or not 64 <= size <= 8192:
-        raise ValueError(f"figure size must be an integer in [64, 8192] pixels, got {size!r}")
     return plt, plt.figure(figsize=(size / 100, (height or size) / 100), dpi=100)
 
 
@@ -66,17 +80,20 @@ def projections(name: str, *, spp: int, dims: int, seed: int = 0, pixel: int = 0
     pixel : int
         Which pixel's point set.
     out : str
-        PNG path.
+        PNG path (must end in .png; checked, with ``size``, before sampling).
     size : int
-        Figure width and height in pixels.
+        Figure width and height in pixels, 64 to 8192.
 
     Returns
     -------
     numpy.ndarray
         The plotted points, float32 ``(spp, dims)``.
     """
+    dims = check_int("dims", dims)
     if not 2 <= dims <= MAX_PLOT_DIMS:
         raise ValueError(f"a projection matrix needs 2 <= dims <= {MAX_PLOT_DIMS}, got {dims}")
+    pixel = check_int("pixel", pixel, 0, MAX_UINT32)
+    _check_figure(out, size)
     smp = make_sampler(name, spp=spp, dims=dims, seed=seed, **options)
     x = smp.generate(pixels=[pixel])[0]
     s = _strata(smp)
@@ -152,17 +169,21 @@ def spectrum(name: str, *, spp: int, dims: tuple[int, int] = (0, 1), trials: int
     energy away from low frequencies (a dark centre, a radial mean below 1
     near 0). The figure shows the spectrum (DC removed) and the radial mean.
 
+    ``out`` must end in .png; it, ``size``, ``trials`` and ``freq`` are
+    checked before sampling.
+
     Returns
     -------
     (spectrum, radii, radial mean)
     """
-    i, j = dims
-    if i == j or min(i, j) < 0:
-        raise ValueError(f"--dims needs two different dimensions i,j >= 0, got {i},{j}")
-    if not 1 <= trials <= 100000:
-        raise ValueError(f"trials must be in [1, 100000], got {trials}")
-    if not 4 <= freq <= 512:
-        raise ValueError(f"freq must be in [4, 512], got {freq}")
+    if not isinstance(dims, (tuple, list)) or len(dims) != 2:
+        raise ValueError(f"dims must be two dimensions (i, j), got {dims!r}")
+    i, j = (check_int("dims", k, 0) for k in dims)
+    if i == j:
+        raise ValueError(f"dims needs two different dimensions i,j >= 0, got {i},{j}")
+    trials = check_int("trials", trials, 1, 100000)
+    freq = check_int("freq", freq, 4, 512)
+    _check_figure(out, size)
     smp = make_sampler(name, spp=spp, dims=max(i, j) + 1, seed=seed, **options)
     x = smp.generate(pixels=range(trials), dims=[i, j])
     p = power_spectrum(x, freq)

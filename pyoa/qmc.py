@@ -21,7 +21,7 @@ from scipy.stats import qmc
 
 from . import constructions
 from .constructions import MAX_DIMS, MAX_UINT32
-from .samplers import Sampler
+from .samplers import ENV_MAX_BYTES, Sampler, format_bytes
 
 __all__ = ["OrthogonalArray", "DEFAULT_SPP_TARGET"]
 
@@ -115,6 +115,11 @@ class OrthogonalArray(qmc.QMCEngine):
     backend : {"opencl", "numpy"}, optional
         pyoa backend (see :func:`pyoa.sampler`); the values are the same bits
         either way.
+    max_bytes : int, float or str, optional
+        Largest array one `random` call may return (``"4G"``, ``0.25`` of
+        RAM...; see :func:`pyoa.sampler`): a larger draw raises a ValueError
+        naming the limit before anything is allocated. Default
+        ``$PYOA_MAX_BYTES``, else half the physical memory.
 
     Attributes
     ----------
@@ -217,7 +222,7 @@ class OrthogonalArray(qmc.QMCEngine):
     """
 
     def __init__(self, d, *, spp=None, sampler="bose", strength=None, offset=None, jitter=1.0,
-                 optimization=None, rng=None, seed=None, backend=None) -> None:
+                 optimization=None, rng=None, seed=None, backend=None, max_bytes=None) -> None:
         if isinstance(d, bool) or not isinstance(d, numbers.Integral) or d < 1:
             raise ValueError(f"d must be a positive integer value, got {d!r}")
         d = int(d)
@@ -247,7 +252,7 @@ class OrthogonalArray(qmc.QMCEngine):
         # pyoa validates spp (naming the nearest valid counts), strength,
         # offset, jitter and backend.
         self.pyoa_sampler = Sampler(name, spp=spp, dims=d, seed=self.pyoa_seed, offset=offset, jitter=jitter,
-                                    strength=strength, backend=backend)
+                                    strength=strength, backend=backend, max_bytes=max_bytes)
         smp = self.pyoa_sampler
         self.sampler_name = smp.name
         self.spp = smp.spp
@@ -256,7 +261,7 @@ class OrthogonalArray(qmc.QMCEngine):
         # Used by `scipy.integrate.qmc_quad` to build independent engines.
         self._init_quad = {"d": d, "spp": self.spp, "sampler": self.sampler_name, "strength": strength,
                            "offset": offset, "jitter": jitter, "optimization": optimization,
-                           "backend": backend}
+                           "backend": backend, "max_bytes": smp.max_bytes}
 
     def __repr__(self) -> str:
         smp = getattr(self, "pyoa_sampler", None)
@@ -276,6 +281,19 @@ class OrthogonalArray(qmc.QMCEngine):
                 f"n={self.num_generated}+{n}={total}."
             )
 
+    def _check_memory(self, n: int) -> None:
+        """Refuse a draw whose float64 result would exceed the sampler's
+        ``max_bytes``, before allocating it (a MemoryError, or worse the
+        machine swapping, is no answer to ``random(10**9)``)."""
+        nbytes = 8 * n * self.d
+        limit = self.pyoa_sampler.max_bytes
+        if nbytes > limit:
+            raise ValueError(
+                f"random(n={n}) needs {format_bytes(nbytes)} for its ({n}, {self.d}) float64 result, over the memory "
+                f"limit of {format_bytes(limit)}; draw fewer points per call, or raise the limit with max_bytes= "
+                f"or ${ENV_MAX_BYTES}"
+            )
+
     def _generate(self, k: int, i0: int, i1: int) -> np.ndarray:
         """Points ``i0 .. i1-1`` of array ``k`` as float32, shape ``(i1 - i0, d)``."""
         return self.pyoa_sampler.generate(pixels=[k], samples=range(i0, i1))[0]
@@ -285,6 +303,7 @@ class OrthogonalArray(qmc.QMCEngine):
         # parallelize on their own.
         n = _count("n", n)
         self._check_room(n)
+        self._check_memory(n)
         out = np.empty((n, self.d), dtype=np.float64)
         if n == 0:
             return out

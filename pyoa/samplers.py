@@ -18,13 +18,14 @@ import math
 import numbers
 import os
 import re
+from collections.abc import Mapping, Sequence, Set
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from . import constructions, reference
 from .backends import choose
-from .constructions import MAX_DIMS, MAX_SPP, MAX_UINT32, OFFSETS
+from .constructions import MAX_DIMS, MAX_SPP, MAX_UINT32, OFFSETS, check_int
 from .request import Request
 
 ENV_MAX_BYTES = "PYOA_MAX_BYTES"
@@ -43,70 +44,204 @@ def _physical_memory() -> int:
         return 8 << 30
 
 
-def parse_bytes(text: str) -> int:
-    """Parse ``"4G"``, ``"512MiB"``, ``"1e9"`` or ``"0.25"`` (a fraction of RAM) into bytes."""
-    m = re.fullmatch(r"\s*([0-9.eE+]+)\s*([kKmMgGtT]?)(i?[bB])?\s*", text)
+#: What :func:`parse_bytes` accepts, for its error messages.
+_BYTES_FORMS = ("an int of bytes (4000000000), a whole number string ('100', '1e9'), a size with a unit "
+                "K, M, G or T, optionally followed by B or iB (powers of 1024: '4G', '512MiB', '1.5GB'), "
+                "or a fraction of RAM in (0, 1] as a float or a string with a decimal point (0.25, '0.5')")
+_SIZE = re.compile(
+    r"\s*(?P<num>(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)\s*"
+    r"(?:(?P<unit>[kKmMgGtT])(?:i?[bB])?|(?P<b>[bB]))?\s*"
+)
+
+
+def _fraction_of_ram(value: float, name: str, text) -> int:
+    if not (math.isfinite(value) and 0 < value <= 1):
+        raise ValueError(f"{name}={text!r}: a number with a decimal point (or a float) is a fraction of RAM and "
+                         f"must be in (0, 1]; for a size in bytes write a whole number or a unit, e.g. '4G'")
+    return _at_least_one_byte(int(value * _physical_memory()), name, text)
+
+
+def _at_least_one_byte(nbytes: int, name: str, text) -> int:
+    if nbytes < 1:
+        raise ValueError(f"{name}={text!r} is less than one byte; give at least 1 (e.g. '1M')")
+    return nbytes
+
+
+def _parse_size(text: str, name: str) -> int:
+    """A memory size string (see :func:`parse_bytes`) in bytes."""
+    m = _SIZE.fullmatch(text)
     if not m:
-        raise ValueError(f"cannot read a memory size from {text!r}; examples: 4G, 512MiB, 0.25 (of RAM)")
-    value = float(m[1])
-    if not m[2] and not m[3] and 0 < value <= 1:
-        return int(value * _physical_memory())
-    return int(value * _UNITS[m[2].lower()])
+        raise ValueError(f"cannot read a memory size from {name}={text!r}; valid: {_BYTES_FORMS}")
+    value = float(m["num"])  # finite unless the exponent is absurd ('1e999')
+    if not math.isfinite(value):
+        raise ValueError(f"{name}={text!r} is not a finite size; valid: {_BYTES_FORMS}")
+    if m["unit"] or m["b"]:
+        nbytes = value * _UNITS[(m["unit"] or "").lower()]
+        if not math.isfinite(nbytes):
+            raise ValueError(f"{name}={text!r} is not a finite size; valid: {_BYTES_FORMS}")
+        return _at_least_one_byte(int(nbytes), name, text)
+    if "." in m["num"]:
+        return _fraction_of_ram(value, name, text)
+    if value != int(value):  # '5e-1': neither whole bytes nor written as a fraction
+        raise ValueError(f"{name}={text!r} is not a whole number of bytes; valid: {_BYTES_FORMS}")
+    return _at_least_one_byte(int(value), name, text)
+
+
+def parse_bytes(value, name: str = "max_bytes") -> int:
+    """A memory size in bytes, from the forms ``max_bytes=`` and ``$PYOA_MAX_BYTES`` accept.
+
+    Parameters
+    ----------
+    value : int, float or str
+        - an int: that many bytes (``4_000_000_000``);
+        - a string of a whole number, optionally in exponent form: bytes
+          (``"100"``, ``"1e9"``);
+        - a string of a number with a unit ``K``, ``M``, ``G`` or ``T``
+          (powers of 1024), optionally followed by ``B`` or ``iB``
+          (``"4G"``, ``"512MiB"``, ``"1.5GB"``), or with ``B`` alone (``"100B"``);
+        - a float, or a string with a decimal point: a fraction of the
+          physical memory, in ``(0, 1]`` (``0.25``, ``"0.5"``, ``"1.0"``).
+    name : str
+        What the value is, for error messages (``"max_bytes"``,
+        ``"$PYOA_MAX_BYTES"``).
+
+    Returns
+    -------
+    int
+        At least 1.
+
+    Raises
+    ------
+    ValueError
+        Anything else, with the valid forms: ``"1.01"`` (neither whole bytes
+        nor a fraction), ``"e"``, ``"-1"``, non-finite values (``"1e999"``,
+        ``float("inf")``), fractions outside ``(0, 1]``, sizes under one byte.
+    TypeError
+        A value that is neither an int, a float nor a str (bools included).
+    """
+    if isinstance(value, str):
+        return _parse_size(value, name)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be an int, a float or a str, got {type(value).__name__} {value!r}; "
+                        f"valid: {_BYTES_FORMS}")
+    if isinstance(value, numbers.Integral):
+        return _at_least_one_byte(int(value), name, value)
+    return _fraction_of_ram(float(value), name, value)
 
 
 def default_max_bytes() -> int:
-    """``$PYOA_MAX_BYTES`` if set, else half of the physical memory."""
+    """``$PYOA_MAX_BYTES`` if set (see :func:`parse_bytes`), else half of the physical memory."""
     env = os.environ.get(ENV_MAX_BYTES)
-    return parse_bytes(env) if env else _physical_memory() // 2
+    return parse_bytes(env, f"${ENV_MAX_BYTES}") if env else _physical_memory() // 2
 
 
-def _fmt_bytes(n: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
-        if n < 1024 or unit == "TiB":
-            return f"{n:.1f} {unit}" if unit != "B" else f"{int(n)} B"
+def format_bytes(n: float) -> str:
+    """``1536`` -> ``"1.5 KiB"`` (binary units, for memory-limit messages)."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{int(n)} B" if unit == "B" else f"{n:.1f} {unit}" if n < 1e6 else f"{n:.3g} {unit}"
         n /= 1024
     return f"{n} B"  # pragma: no cover
 
 
-def _int(name: str, value, lo: int | None = None, hi: int | None = None) -> int:
-    """``value`` as a Python int in ``[lo, hi]``; bools and floats are refused."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
-    value = int(value)
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        rng = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
-        raise ValueError(f"{name} must be {rng}, got {value}")
-    return value
+_int = check_int  # the checker of every count argument (pyoa.analysis uses it too)
 
 
-def _indices(name: str, value, size: int, default) -> np.ndarray:
-    """Validate a range or a sequence of ints in ``[0, size)``; returns uint32."""
-    if value is None:
-        value = default
+#: Bytes per index of a request: pixels, samples and dims are held as uint32.
+INDEX_BYTES = 4
+
+
+def _index_kind_error(name: str, value) -> TypeError:
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        hint = f"e.g. [{value}] or range({value})" if value >= 0 else "e.g. [3] or range(4)"
+    else:
+        hint = "e.g. [3] or range(4)"
+    why = " (a set or dict has no order)" if isinstance(value, (Set, Mapping)) else ""
+    return TypeError(f"{name} must be a range or a sequence of ints (a list, a tuple or a 1-D integer array), "
+                     f"{hint}; got {type(value).__name__}{why}")
+
+
+def _index_length(name: str, value, size: int) -> int:
+    """How many indices ``value`` names, after checking its kind (and a range's
+    bounds), without building anything: requests are size-checked first."""
     if isinstance(value, range):
         # Check the end points, not len(): len() of a range with 2**63 or
         # more elements raises OverflowError. In-bounds end points bound the
         # length by `size`.
         if value and not (0 <= min(value[0], value[-1]) and max(value[0], value[-1]) < size):
             raise ValueError(f"{name} must lie in [0, {size}), got {value}")
-        return np.arange(value.start, value.stop, value.step, dtype=np.int64).astype(np.uint32)
-    if isinstance(value, (str, bytes)) or np.isscalar(value) or not hasattr(value, "__len__"):
-        raise TypeError(f"{name} must be a range or a sequence of ints, e.g. [3] or range(4); got {type(value).__name__}")
-    arr = np.asarray(value)
-    if arr.size == 0:
-        return np.zeros(0, np.uint32)
-    if arr.ndim != 1:
-        raise ValueError(f"{name} must be one-dimensional, got shape {arr.shape}")
-    if arr.dtype == bool or not np.issubdtype(arr.dtype, np.integer):
-        if arr.dtype == object and all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in arr):
-            arr = np.array([int(v) for v in arr], dtype=object)
-        else:
-            raise TypeError(f"{name} must hold integers, got dtype {arr.dtype}")
-    lo, hi = int(arr.min()), int(arr.max())
+        return len(value)
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            raise _index_kind_error(name, value[()])
+        if value.ndim != 1:
+            raise ValueError(f"{name} must be one-dimensional, got an array of shape {value.shape}")
+        return len(value)
+    if isinstance(value, (str, bytes, bytearray)) or not isinstance(value, Sequence):
+        if hasattr(value, "__array__") and not np.isscalar(value):  # array-likes: pandas, xarray...
+            return _index_length(name, np.asarray(value), size)
+        raise _index_kind_error(name, value)
+    return len(value)
+
+
+def _checked_items(name: str, items) -> None:
+    """Raise for the first entry of a flat sequence that is not an integer."""
+    if all(type(v) is int for v in items):  # the common case, fast
+        return
+    for k, v in enumerate(items):
+        if isinstance(v, (Sequence, np.ndarray)) and not isinstance(v, (str, bytes)):
+            raise ValueError(f"{name} must be one-dimensional (a flat sequence of ints), "
+                             f"got a {type(v).__name__} at position {k}")
+        # NumPy registers timedelta64 as an integer type; it is a duration, not an index
+        if isinstance(v, (bool, np.bool_, np.timedelta64)) or not isinstance(v, numbers.Integral):
+            raise TypeError(f"{name} must hold integers, got {type(v).__name__} {v!r} at position {k}")
+
+
+def _in_bounds(name: str, lo: int, hi: int, size: int) -> None:
     if lo < 0 or hi >= size:
-        bad = lo if lo < 0 else hi
-        raise ValueError(f"{name} must lie in [0, {size}), got {bad}")
-    return arr.astype(np.uint32)
+        raise ValueError(f"{name} must lie in [0, {size}), got {lo if lo < 0 else hi}")
+
+
+def _range_indices(value: range) -> np.ndarray:
+    """A checked range as uint32, built in place (no int64 temporary: a large
+    pixel range would need twice the memory the size check allowed for)."""
+    n = len(value)
+    out = np.arange(n, dtype=np.uint32)
+    if value.step > 0:  # every start + k * step is a valid uint32, so no step wraps
+        out *= np.uint32(value.step)
+        out += np.uint32(value.start)
+    elif n:
+        out *= np.uint32(-value.step)
+        np.subtract(np.uint32(value.start), out, out=out)
+    return out
+
+
+def _indices(name: str, value, size: int) -> np.ndarray:
+    """Validate a range or a flat sequence of ints in ``[0, size)``; returns uint32.
+
+    Raises TypeError for anything that is not a range or a sequence of
+    integers (bools, floats, strings, sets, dicts, datetime values, a bare
+    int) and ValueError for nested sequences and out-of-range entries, each
+    naming ``name``.
+    """
+    _index_length(name, value, size)
+    if isinstance(value, range):
+        return _range_indices(value)
+    if not isinstance(value, np.ndarray) and not isinstance(value, Sequence):
+        value = np.asarray(value)  # an array-like (see _index_length)
+    if isinstance(value, np.ndarray) and value.dtype != object:
+        if value.dtype.kind not in "iu":  # "m" (timedelta64) is an integer subtype to NumPy
+            raise TypeError(f"{name} must hold integers, got an array of dtype {value.dtype}")
+        if value.size == 0:
+            return np.zeros(0, np.uint32)
+        _in_bounds(name, int(value.min()), int(value.max()), size)
+        return value.astype(np.uint32)
+    items = value.tolist() if isinstance(value, np.ndarray) else value
+    if len(items) == 0:
+        return np.zeros(0, np.uint32)
+    _checked_items(name, items)
+    _in_bounds(name, int(min(items)), int(max(items)), size)
+    return np.fromiter(items, dtype=np.uint32, count=len(items))
 
 
 class Sampler:
@@ -117,7 +252,11 @@ class Sampler:
     samplers (``random``, ``jittered2d``, ``cmj2d``, ``sobol02``, ``halton``,
     ``sobol``) share this class, its API and its bit-exactness guarantees.
 
-    Create one with :func:`sampler`. Immutable and safe to share between threads.
+    Create one with :func:`sampler`. Immutable (setting or deleting an
+    attribute raises AttributeError: make a new sampler instead) and safe to
+    share between threads. It pickles and deep-copies as its parameters: the
+    copy, in this process or a worker, opens its own backend (the same
+    backend name and device selector) and gives the same bits.
 
     Attributes
     ----------
@@ -146,45 +285,57 @@ class Sampler:
     backend : str
         ``"opencl"`` or ``"numpy"``; ``device`` describes what it runs on.
     max_bytes : int
-        Largest array :meth:`generate` will allocate.
+        Largest request :meth:`generate` accepts, in bytes: its float32
+        values plus its uint32 index arrays.
     """
 
     def __init__(self, name, *, spp, dims, seed=0, offset=None, jitter=1.0, strength=None,
                  backend=None, device=None, max_bytes=None):
-        self._construction = constructions.get(name)
-        self.name = self._construction.name
-        self.spp = _int("spp", spp, 1, MAX_SPP)
-        self.dims = _int("dims", dims, 1, MAX_DIMS)
-        self.seed = _int("seed", seed, 0, MAX_UINT32)
+        construction = constructions.get(name)
+        spp = _int("spp", spp, 1, MAX_SPP)
+        dims = _int("dims", dims, 1, MAX_DIMS)
+        seed = _int("seed", seed, 0, MAX_UINT32)
         if strength is not None:
             strength = _int("strength", strength, 1)
-        is_oa = self._construction.family == "oa"
-        if offset is None:
-            offset = "cmj" if is_oa else None
-        elif not is_oa:
-            raise ValueError(f"offset applies to the orthogonal-array samplers only; {self.name} has none "
-                             f"(got offset={offset!r})")
-        elif not isinstance(offset, str) or offset not in OFFSETS:
-            raise ValueError(f"unknown offset {offset!r}; valid: {', '.join(OFFSETS)} (default 'cmj')")
-        self.offset = offset
-        if isinstance(jitter, bool) or not isinstance(jitter, numbers.Real):
-            raise TypeError(f"jitter must be a real number in [0, 1], got {type(jitter).__name__}")
-        if not 0.0 <= float(jitter) <= 1.0:  # NaN fails too
-            raise ValueError(f"jitter must be in [0, 1] (1 = full jitter, 0 = cell centres), got {jitter}")
-        if not (is_oa or self._construction.jittered) and float(jitter) != 1.0:
-            raise ValueError(f"{self.name} has no jitter amount (got jitter={jitter}); it applies to the "
-                             "orthogonal-array samplers, jittered2d and cmj2d")
-        self.jitter = float(np.float32(jitter))
-        self.params = self._construction.resolve(self.spp, self.dims, strength)
-        self.s, self.strength, self.block_dims = self.params.s, self.params.strength, self.params.block_dims
-        if max_bytes is None:
-            max_bytes = default_max_bytes()
-        elif isinstance(max_bytes, str):
-            max_bytes = parse_bytes(max_bytes)
-        self.max_bytes = _int("max_bytes", max_bytes, 1)
-        self._backend = choose(backend, device)
-        self.backend = self._backend.name
-        self.device = self._backend.describe()
+        offset = _offset(construction, offset)
+        jitter = _jitter(construction, jitter)
+        params = construction.resolve(spp, dims, strength)
+        max_bytes = default_max_bytes() if max_bytes is None else parse_bytes(max_bytes, "max_bytes")
+        impl = choose(backend, device)
+        # Every attribute is set here and never again (see __setattr__).
+        fields = dict(
+            _construction=construction, name=construction.name, spp=spp, dims=dims, seed=seed, offset=offset,
+            jitter=jitter, params=params, s=params.s, strength=params.strength, block_dims=params.block_dims,
+            max_bytes=max_bytes, _backend=impl, _device_selector=device, backend=impl.name,
+            device=impl.describe(),
+        )
+        for key, value in fields.items():
+            object.__setattr__(self, key, value)
+
+    def __setattr__(self, key, value):
+        raise AttributeError(f"cannot set {key!r}: samplers are immutable; make a new one with "
+                             f"pyoa.sampler(...)")
+
+    def __delattr__(self, key):
+        raise AttributeError(f"cannot delete {key!r}: samplers are immutable; make a new one with "
+                             f"pyoa.sampler(...)")
+
+    def _arguments(self) -> dict:
+        """The keyword arguments of :func:`sampler` that make this sampler again."""
+        return dict(
+            spp=self.spp, dims=self.dims, seed=self.seed, offset=self.offset, jitter=self.jitter,
+            # the resolved strength, so the copy cannot resolve another one; the
+            # comparison samplers take none
+            strength=self.strength if self._construction.family == "oa" else None,
+            backend=self.backend, device=self._device_selector, max_bytes=self.max_bytes,
+        )
+
+    def __reduce__(self):
+        # An OpenCL backend holds a context, queue and program that cannot be
+        # pickled: a sampler travels as its parameters, and the other side
+        # (a worker process) opens its own device. The backend is named
+        # explicitly, so the copy never silently falls back to another one.
+        return (_rebuild, (self.name, self._arguments()))
 
     def __repr__(self) -> str:
         if self._construction.family != "oa":
@@ -202,16 +353,37 @@ class Sampler:
         )
 
     def _request(self, pixels, samples, dims) -> Request:
+        pixels, samples, dims = self._checked_size(pixels, samples, dims)
         return Request(
             construction=self._construction,
             params=self.params,
             seed=self.seed,
             offset=self.offset,
             jitter=self.jitter,
-            pixels=_indices("pixels", pixels, MAX_UINT32 + 1, [0]),
-            samples=_indices("samples", samples, self.spp, range(self.spp)),
-            dims=_indices("dims", dims, self.dims, range(self.dims)),
+            pixels=_indices("pixels", pixels, MAX_UINT32 + 1),
+            samples=_indices("samples", samples, self.spp),
+            dims=_indices("dims", dims, self.dims),
         )
+
+    def _checked_size(self, pixels, samples, dims) -> tuple:
+        """The index arguments with their defaults, once the whole request (its
+        float32 values and its uint32 index arrays) is known to fit in
+        ``max_bytes``: checked before anything is built, so a huge range is
+        refused at once instead of filling memory first."""
+        pixels = [0] if pixels is None else pixels
+        samples = range(self.spp) if samples is None else samples
+        dims = range(self.dims) if dims is None else dims
+        n_p = _index_length("pixels", pixels, MAX_UINT32 + 1)
+        n_s = _index_length("samples", samples, self.spp)
+        n_d = _index_length("dims", dims, self.dims)
+        nbytes = 4 * n_p * n_s * n_d + INDEX_BYTES * (n_p + n_s + n_d)
+        if nbytes > self.max_bytes:
+            raise ValueError(
+                f"request of {n_p} x {n_s} x {n_d} float32 values needs {format_bytes(nbytes)} (with its "
+                f"index arrays), over the memory limit of {format_bytes(self.max_bytes)}; ask for fewer pixels "
+                f"at a time, or raise the limit with max_bytes= or ${ENV_MAX_BYTES}"
+            )
+        return pixels, samples, dims
 
     def generate(self, pixels=None, samples=None, dims=None, *, out: np.ndarray | None = None,
                  progress: bool = False) -> np.ndarray:
@@ -244,21 +416,18 @@ class Sampler:
         Raises
         ------
         ValueError
-            An index out of range, a request larger than ``max_bytes``, or an
+            An index out of range, a nested sequence, a request larger than
+            ``max_bytes`` (its values, 4 bytes each, plus its index arrays, 4
+            bytes per index; checked before anything is allocated), or an
             ``out`` of the wrong shape.
         TypeError
-            An argument that is not a range or a sequence of ints, or an
-            ``out`` that is not a writeable C-contiguous float32 ndarray.
+            An argument that is not a range or a sequence of ints (a bare int
+            such as ``4``: write ``[4]`` or ``range(4)``; a set; floats, bools,
+            datetime values), or an ``out`` that is not a writeable
+            C-contiguous float32 ndarray.
         """
         req = self._request(pixels, samples, dims)
         shape = (len(req.pixels), len(req.samples), req.n_dims)
-        nbytes = 4 * math.prod(shape)
-        if nbytes > self.max_bytes:
-            raise ValueError(
-                f"request of {shape[0]} x {shape[1]} x {shape[2]} float32 values needs {_fmt_bytes(nbytes)}, "
-                f"over the memory limit of {_fmt_bytes(self.max_bytes)}; ask for fewer pixels at a time, "
-                f"or raise the limit with max_bytes= or ${ENV_MAX_BYTES}"
-            )
         out = _output(out, shape)
         rows = out.reshape(req.n_rows, req.n_dims)
         step = self._backend.rows_per_chunk(req.n_dims)
@@ -304,6 +473,36 @@ class Sampler:
         return float(self._construction.call("pyoa.reference", i, j, self.params, p, self.offset, self.jitter))
 
 
+def _rebuild(name: str, arguments: dict) -> Sampler:
+    """Unpickle a :class:`Sampler` (see ``Sampler.__reduce__``)."""
+    return Sampler(name, **arguments)
+
+
+def _offset(construction, offset):
+    """The checked offset style: ``"cmj"`` by default for the OA samplers, None for the others."""
+    is_oa = construction.family == "oa"
+    if offset is None:
+        return "cmj" if is_oa else None
+    if not is_oa:
+        raise ValueError(f"offset applies to the orthogonal-array samplers only; {construction.name} has none "
+                         f"(got offset={offset!r})")
+    if not isinstance(offset, str) or offset not in OFFSETS:
+        raise ValueError(f"unknown offset {offset!r}; valid: {', '.join(OFFSETS)} (default 'cmj')")
+    return offset
+
+
+def _jitter(construction, jitter) -> float:
+    """The checked jitter amount, rounded to float32 as the kernels use it."""
+    if isinstance(jitter, bool) or not isinstance(jitter, numbers.Real):
+        raise TypeError(f"jitter must be a real number in [0, 1], got {type(jitter).__name__}")
+    if not 0.0 <= float(jitter) <= 1.0:  # NaN fails too
+        raise ValueError(f"jitter must be in [0, 1] (1 = full jitter, 0 = cell centres), got {jitter}")
+    if not (construction.family == "oa" or construction.jittered) and float(jitter) != 1.0:
+        raise ValueError(f"{construction.name} has no jitter amount (got jitter={jitter}); it applies to the "
+                         "orthogonal-array samplers, jittered2d and cmj2d")
+    return float(np.float32(jitter))
+
+
 def _output(out, shape: tuple[int, ...]) -> np.ndarray:
     """``out`` checked as the destination of a result of ``shape``, or a new array."""
     if out is None:
@@ -322,7 +521,7 @@ def _output(out, shape: tuple[int, ...]) -> np.ndarray:
 
 def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None = None, jitter: float = 1.0,
             strength: int | None = None, backend: str | None = None, device: str | None = None,
-            max_bytes: int | str | None = None) -> Sampler:
+            max_bytes: int | float | str | None = None) -> Sampler:
     """Create a sampler: an orthogonal array or one of the paper's comparison samplers.
 
     Parameters
@@ -362,11 +561,18 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         Default: ``$PYOA_BACKEND``, else OpenCL if usable, else NumPy with a
         warning (see :mod:`pyoa.backends`).
     device : str, optional
-        OpenCL device selector (``"gpu"``, ``"1:0"``, ``"nvidia"``...); default
-        ``$PYOA_OPENCL_DEVICE``, else PoCL's CPU device.
-    max_bytes : int or str, optional
-        Largest array :meth:`Sampler.generate` may return (``"4G"``, ``0.25``
-        of RAM...); default ``$PYOA_MAX_BYTES``, else half the physical memory.
+        OpenCL device selector, a str: ``"P:D"`` (device D of platform P, as
+        ``pyoa backends`` lists them), ``"P"`` (device 0 of platform P),
+        ``"gpu"``, ``"cpu"``, ``"accelerator"``, or text found in the
+        platform or device name (``"nvidia"``); see :mod:`pyoa._opencl.device`.
+        Default ``$PYOA_OPENCL_DEVICE`` (same forms), else the first of PoCL's
+        CPU device and the others that builds pyoa's kernels.
+    max_bytes : int, float or str, optional
+        Largest request :meth:`Sampler.generate` accepts (its float32 values
+        plus its index arrays): an int of bytes, a string with a unit
+        (``"4G"``, ``"512MiB"``), or a fraction of RAM in (0, 1] (``0.25``,
+        ``"0.25"``); see :func:`parse_bytes`. Default ``$PYOA_MAX_BYTES``
+        (same forms), else half the physical memory.
 
     Examples
     --------
@@ -375,7 +581,7 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
     >>> x = smp.generate(pixels=range(4))
     >>> x.shape, x.dtype
     ((4, 121, 8), dtype('float32'))
-    >>> smp.value(pixel=3, i=17, j=5) == x[3, 17, 5]
+    >>> bool(smp.value(pixel=3, i=17, j=5) == x[3, 17, 5])
     True
     """
     return Sampler(name, spp=spp, dims=dims, seed=seed, offset=offset, jitter=jitter, strength=strength,

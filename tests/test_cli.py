@@ -126,24 +126,29 @@ def test_failed_npy_write_leaves_old_file(tmp_path, capsys, monkeypatch, exc):
         raise exc
 
     monkeypatch.setattr(np, "save", half_save)
-    with pytest.raises(type(exc)):
-        cli.main(["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", str(out), "-q"])
+    argv = ["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", str(out), "-q"]
+    if isinstance(exc, OSError):  # a write error is a one-line error naming the user's file, exit 2
+        code, _, err = run_cli(argv, capsys)
+        assert code == 2 and err == f"pyoa points: error: cannot write {str(out)!r}: disk full\n"
+    else:
+        with pytest.raises(type(exc)):
+            cli.main(argv)
     assert seen and seen[0] != str(out)  # it wrote elsewhere first
     assert out.read_bytes() == old
     assert leftovers(tmp_path, "x.npy") == [], os.listdir(tmp_path)
 
 
-def test_failed_csv_write_leaves_old_file(tmp_path, monkeypatch):
+def test_failed_csv_write_leaves_old_file(tmp_path, capsys, monkeypatch):
     out = tmp_path / "x.csv"
     old = _good_file(out)
 
     def half_savetxt(fh, arr, *a, **k):
         fh.write("0,0,0.5\n")
-        raise OSError("disk full")
+        raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(np, "savetxt", half_savetxt)
-    with pytest.raises(OSError, match="disk full"):
-        cli.main(["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", str(out), "-q"])
+    code, _, err = run_cli(["points", "--spp", "9", "--dims", "2", "--backend", "numpy", "--out", out, "-q"], capsys)
+    assert code == 2 and err == f"pyoa points: error: cannot write {str(out)!r}: No space left on device\n"
     assert out.read_bytes() == old
     assert leftovers(tmp_path, "x.csv") == []
 

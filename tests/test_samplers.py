@@ -240,7 +240,8 @@ def test_valid_spp_index2():
     assert [c.spp for c in pyoa.valid_spp("addelman-kempthorne", near=162)] == [98, 162]  # |98-162| < |242-162|
     for name in ("addelman-kempthorne", "bose-bush"):
         assert pyoa.valid_spp(name, strength=2) == pyoa.valid_spp(name)
-        assert pyoa.valid_spp(name, strength=3) == []
+        with pytest.raises(ValueError, match="strength 2 only"):  # as pyoa.sampler refuses it
+            pyoa.valid_spp(name, strength=3)
         assert pyoa.valid_spp(name, dims=1) == pyoa.valid_spp(name)
 
 
@@ -361,12 +362,16 @@ def test_max_bytes(backend):
         s.generate()
     msg = str(exc.value)
     assert "1 x 121 x 8" in msg
-    assert "3.8 KiB" in msg  # 121 * 8 * 4 = 3872 bytes
+    assert "4.3 KiB" in msg  # 121 * 8 * 4 = 3872 bytes of values + 4 * (1 + 121 + 8) of indices
     assert "1000 B" in msg and "max_bytes" in msg
     # the cap is on the request, not the sampler: a smaller request fits
-    assert s.generate(samples=range(31)).shape == (1, 31, 8)  # 992 bytes
-    exact = pyoa.sampler("bose", spp=121, dims=8, max_bytes=121 * 8 * 4, backend=backend)
+    assert s.generate(samples=range(26)).shape == (1, 26, 8)  # 832 + 4 * 35 = 972 bytes
+    with pytest.raises(ValueError):
+        s.generate(samples=range(27))  # 864 + 4 * 36 = 1008 bytes
+    exact = pyoa.sampler("bose", spp=121, dims=8, max_bytes=121 * 8 * 4 + 4 * 130, backend=backend)
     assert exact.generate().shape == (1, 121, 8)
+    with pytest.raises(ValueError):
+        pyoa.sampler("bose", spp=121, dims=8, max_bytes=121 * 8 * 4 + 4 * 130 - 1, backend=backend).generate()
 
 
 def test_max_bytes_large_request_message():

@@ -14,6 +14,9 @@ A *selector* (the ``device=`` argument of :func:`pyoa.sampler` or the
 ``PYOA_OPENCL_DEVICE`` environment variable) picks another device:
 
 - ``"P:D"``: device D of platform P in :func:`list_devices` order;
+- ``"P"`` (a bare integer): device 0 of platform P, as in PyOpenCL's
+  ``PYOPENCL_CTX`` (never a substring of a name: ``"0"`` would otherwise
+  pick whichever device happens to have a 0 in its description);
 - ``"gpu"``, ``"cpu"`` or ``"accelerator"``: the first device of that type;
 - any other text: the first device whose ``"platform version / device"``
   description contains it, case-insensitively (e.g. ``"nvidia"``, ``"pocl"``).
@@ -186,9 +189,11 @@ def select_device(selector: str | None = None) -> DeviceInfo:
         return candidates()[0]
     devices = list_devices()
     sel = selector.strip().lower()
-    m = re.fullmatch(r"(\d+):(\d+)", sel)
+    m = re.fullmatch(r"(\d+)(?::(\d+))?", sel)
+    if m:  # "P" is "P:0"
+        m = (int(m[1]), int(m[2] or 0))
     for info in devices:
-        if m and (info.platform_index, info.device_index) == (int(m[1]), int(m[2])):
+        if m and (info.platform_index, info.device_index) == m:
             return info
         if not m and (sel == info.kind or sel in f"{info.platform.name} {info.platform.version} / {info.device.name}".lower()):
             return info

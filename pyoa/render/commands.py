@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
-import os
+import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -13,9 +15,20 @@ import numpy as np
 from .. import constructions
 from ..atomic import atomic_path
 from ..cli import _rate
-from .image import read_image, rel_mse, write_exr, write_png
-from .render import SHADINGS, render
+from ..constructions import MAX_SPP, MAX_UINT32
+from .image import (EXR, PNG, check_crop, check_finite, check_output, check_writable, read_reference, rel_mse,
+                    write_exr, write_png)
+from .layout import MAX_DEPTH
+from .render import SHADINGS, check_memory, plan, render, resolve_shading
 from .scene import load
+
+#: Bytes per pixel that a command allocates besides the render, bounded: the
+#: PNG's float64 sRGB conversion, the reference and the float64 copies of
+#: relMSE (``pyoa render``, ``pyoa compare``), the float64 running sum, its
+#: pass and the mean (``pyoa reference``).
+POST_PIXEL_BYTES = 256
+#: Most passes of ``pyoa reference``: pass seeds hash a uint32 pass index.
+MAX_PASSES = MAX_UINT32 + 1
 
 
 def _size(args) -> dict:
@@ -24,20 +37,55 @@ def _size(args) -> dict:
     return dict(width=w, height=h)
 
 
-def _reference(path, shape):
-    ref = read_image(path)[..., :3]
-    if ref.shape != shape:
-        raise ValueError(f"reference {path!r} is {ref.shape[1]} x {ref.shape[0]}, the render is "
-                         f"{shape[1]} x {shape[0]}; render with --size {ref.shape[1]} {ref.shape[0]}")
-    return ref
+def _in_range(option: str, value: int, lo: int, hi: int | None = None, why: str = "") -> None:
+    if value < lo or (hi is not None and value > hi):
+        rng = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
+        raise ValueError(f"{option} must be {rng}{why}, got {value}")
+
+
+def _check_counts(args, spp: bool = True) -> None:
+    """Refuse out-of-range counts of the options every command shares, before
+    anything is loaded or rendered (0 is refused, never read as a default)."""
+    if spp:
+        _in_range("--spp", args.spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
+    _in_range("--seed", args.seed, 0, MAX_UINT32, " (a uint32)")
+    if args.max_depth is not None:
+        _in_range("--max-depth", args.max_depth, 1, MAX_DEPTH)
+    if args.size is not None:
+        for name, v in zip(("W", "H"), args.size):
+            _in_range(f"--size {name}", v, 1)
+
+
+def _check_job_memory(p, what: str) -> None:
+    """The render's own need plus what the command allocates after it, against the same limit."""
+    check_memory(p.nbytes + p.width * p.height * POST_PIXEL_BYTES, what, p.max_bytes)
+
+
+def _plan(scene, args, sampler: str, spp: int, seed: int | None = None):
+    return plan(scene, sampler=sampler, spp=spp, seed=args.seed if seed is None else seed, **_size(args),
+                max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend)
 
 
 def cmd_render(args) -> int:
+    _check_counts(args)
+    if args.crop and not args.reference:
+        raise ValueError("--crop needs --reference: it is the window of the relative MSE against it")
+    check_output(args.out, "--out", EXR)
+    if args.png:
+        check_output(args.png, "--png", PNG)
     scene = load(args.scene)
+    p = _plan(scene, args, args.sampler, args.spp)
+    _check_job_memory(p, f"pyoa render of {p.width} x {p.height} at {p.sampler.spp} spp")
+    ref = None
+    if args.reference:
+        ref = read_reference(args.reference, "--reference", p.width, p.height)
+        if args.crop:
+            check_crop(args.crop, p.width, p.height)
     res = render(scene, sampler=args.sampler, spp=args.spp, seed=args.seed,
                  **_size(args),
                  max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
                  shading=args.shading, progress=not args.quiet)
+    check_finite(res.image, f"--out {args.out!r} not written")  # before either file is written
     write_exr(args.out, res.image)
     if args.png:
         write_png(args.png, res.image)
@@ -46,8 +94,7 @@ def cmd_render(args) -> int:
         print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
         print(f"{res.seconds:.2f} s, {_rate(res.paths_per_second)}paths/s, {_rate(res.rays_per_second)}rays/s "
               f"-> {args.out}{' and ' + args.png if args.png else ''}")
-    if args.reference:
-        ref = _reference(args.reference, res.image.shape)
+    if ref is not None:
         line = f"relMSE {rel_mse(res.image, ref):.6g}"
         if args.crop:
             line += f", crop {rel_mse(res.image, ref, args.crop):.6g}"
@@ -55,23 +102,45 @@ def cmd_render(args) -> int:
     return 0
 
 
+def _compare_outputs(out: str) -> list[Path]:
+    """STEM.md, STEM.csv and STEM.png of ``--out STEM``, each checked writable."""
+    stem = Path(out)
+    if stem.name in ("", ".", "..") or stem.is_dir():
+        raise ValueError(f"--out {out!r} is a directory; give a stem such as {str(stem / 'compare')!r} "
+                         "(writes STEM.md, STEM.csv, STEM.png)")
+    paths = [stem.with_suffix(s) for s in (".md", ".csv", ".png")]
+    for path in paths:
+        check_writable(path, "--out")
+    return paths
+
+
 def cmd_compare(args) -> int:
-    scene = load(args.scene)
     names = [n.strip() for n in args.samplers.split(",") if n.strip()]
+    if not names:
+        raise ValueError(f"--samplers {args.samplers!r} names no sampler; give a comma-separated list such as "
+                         "bose,sobol (see pyoa samplers)")
     for n in names:
         constructions.get(n)  # unknown names fail before any rendering
-    ref = None
+    _check_counts(args)
+    md_path, csv_path, png_path = _compare_outputs(args.out)
+    scene = load(args.scene)
+    jobs = []
+    for name in names:  # every sampler's render is checked before the first one starts
+        spp = constructions.nearest_spp(name, args.spp)
+        p = _plan(scene, args, name, spp)
+        _check_job_memory(p, f"pyoa compare of {p.width} x {p.height} at {spp} spp ({name})")
+        jobs.append((name, spp))
+    ref = read_reference(args.reference, "--reference", p.width, p.height)
+    crop = args.crop or _default_crop(ref.shape)
+    check_crop(crop, p.width, p.height)
     rows = []
     crops = []
-    for name in names:
-        spp = constructions.nearest_spp(name, args.spp)
+    for name, spp in jobs:
         res = render(scene, sampler=name, spp=spp, seed=args.seed,
                      **_size(args),
                      max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
                      shading=args.shading, progress=not args.quiet)
-        if ref is None:
-            ref = _reference(args.reference, res.image.shape)
-        crop = args.crop or _default_crop(res.image.shape)
+        check_finite(res.image, f"the {name} render ({spp} spp)")  # a NaN relMSE is no answer
         rows.append(dict(sampler=name, spp=spp, note="" if spp == args.spp else f"nearest valid to {args.spp}",
                          relmse=rel_mse(res.image, ref), relmse_crop=rel_mse(res.image, ref, crop),
                          seconds=round(res.seconds, 3)))
@@ -82,19 +151,18 @@ def cmd_compare(args) -> int:
                   f"({res.seconds:.1f} s)")
     md = markdown_table(scene.name, rows, crop)
     print(md)
-    stem = Path(args.out)
-    with atomic_path(stem.with_suffix(".md")) as tmp:
+    with atomic_path(md_path) as tmp:
         tmp.write_text(md)
-    with atomic_path(stem.with_suffix(".csv")) as tmp:
+    with atomic_path(csv_path) as tmp:
         buf = io.StringIO()
         wr = csv.DictWriter(buf, fieldnames=list(rows[0]))
         wr.writeheader()
         wr.writerows(rows)
         tmp.write_text(buf.getvalue())
     x, y, w, h = crop
-    crop_figure(stem.with_suffix(".png"), crops, ref[y:y + h, x:x + w])
+    crop_figure(png_path, crops, ref[y:y + h, x:x + w])
     if not args.quiet:
-        print(f"-> {stem.with_suffix('.md')}, {stem.with_suffix('.csv')}, {stem.with_suffix('.png')}")
+        print(f"-> {md_path}, {csv_path}, {png_path}")
     return 0
 
 
@@ -146,35 +214,144 @@ def pass_seed(seed: int, k: int) -> int:
     return hash_pair(seed, k, REFERENCE_KEY)
 
 
+#: Version of the state file's layout and key (a state of another version is not resumed).
+STATE_VERSION = 2
+#: Options named when a state's key differs from this run's (key field -> how to say it).
+_KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
+               "width": "--size W", "height": "--size H", "max_depth": "--max-depth", "sampler": "--sampler", "pass_spp": "--pass-spp", "passes": "--spp",
+               "seed": "--seed", "filter": "--filter", "first": "--first", "shading": "--shading"}
+
+
+def _scene_digest(scene) -> str:
+    """SHA-256 of what a scene renders: its file's bytes and its world-space
+    triangles (which include every mesh file it reads)."""
+    h = hashlib.sha256(Path(scene.path).read_bytes())
+    h.update(np.ascontiguousarray(scene.triangles).tobytes())
+    return h.hexdigest()
+
+
+def _reference_key(scene, args, p, passes: int) -> dict:
+    """Every setting that changes the bits of a reference pass (the backend
+    does not: every backend gives the same samples)."""
+    return dict(version=STATE_VERSION, scene=_scene_digest(scene), width=p.width, height=p.height,
+                max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=args.pass_spp, passes=passes,
+                seed=args.seed, filter=args.filter, first=list(p.layout.names),
+                shading=resolve_shading(args.shading))
+
+
+class _BadState(Exception):
+    """A state file that cannot be resumed (the message says why)."""
+
+
+def _describe_change(saved: dict, key: dict) -> str:
+    """Why a saved key is not this run's, as the user would set it: the first field that differs."""
+    for field, option in _KEY_FIELDS.items():
+        if saved.get(field) != key[field]:
+            if field in ("scene", "first", "version"):
+                return f"made with {option}"
+            if field == "passes":  # say it as the user gave it: --spp, the total
+                return f"made with --spp {_total_spp(saved)}, not {_total_spp(key)}"
+            return f"made with {option} {saved.get(field)}, not {key[field]}"
+    return "made with other settings"  # pragma: no cover - keys differ in a field not listed
+
+
+def _total_spp(key: dict):
+    """--spp of a run from its key (passes x pass_spp); "?" for a key without them."""
+    try:
+        return int(key["passes"]) * int(key["pass_spp"])
+    except (KeyError, TypeError, ValueError):
+        return "?"
+
+
+def _read_state(state: Path, key: dict) -> tuple[np.ndarray | None, int]:
+    """``(sum, done)`` saved in ``state`` for this run's ``key``; raises
+    _BadState when it cannot be resumed: unreadable, another run's, or
+    holding counts, a shape or values a mean of ``key``'s passes cannot have."""
+    shape = (key["height"], key["width"], 3)
+    limit = {"key.npy": 1 << 20, "passes.npy": 1 << 10, "sum.npy": 8 * int(np.prod(shape)) + (1 << 10)}
+    try:
+        with zipfile.ZipFile(state) as zf:
+            for info in zf.infolist():  # refuse a member larger than it can be before reading any
+                if info.file_size > limit.get(info.filename, 0):
+                    raise _BadState(f"unexpected member {info.filename!r} of {info.file_size} bytes")
+        with np.load(state, allow_pickle=False) as st:
+            try:
+                saved = json.loads(str(st["key"][()]))
+            except ValueError:
+                saved = None
+            if not isinstance(saved, dict):
+                raise _BadState("its key is not a JSON object")
+            if saved != key:
+                raise _BadState(_describe_change(saved, key))
+            done = st["passes"]
+            if done.shape != () or done.dtype.kind not in "iu" or not 0 <= int(done) <= key["passes"]:
+                raise _BadState(f"it counts {done.tolist()!r} passes done, not 0 to {key['passes']}")
+            done = int(done)
+            total = st["sum"]
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:  # truncated, empty, key-less
+        first = (str(exc).strip().splitlines() or [""])[0]
+        raise _BadState(f"unreadable ({type(exc).__name__}: {first})" if first else
+                        f"unreadable ({type(exc).__name__})") from None
+    if total.shape != shape or total.dtype != np.float64:
+        raise _BadState(f"its sum is {total.dtype} {total.shape}, not float64 {shape}")
+    if not np.isfinite(total).all():
+        raise _BadState("its sum holds NaN or inf")
+    return (total if done else None), done
+
+
+def _resume(state: Path, key: dict, quiet: bool) -> tuple[np.ndarray | None, int]:
+    """The saved sum and pass count to resume from, or (None, 0) to start
+    over, saying why on stderr: a state that is not this run's is never
+    mixed into its mean."""
+    if not state.exists():
+        return None, 0
+    try:
+        total, done = _read_state(state, key)
+    except _BadState as why:
+        print(f"pyoa reference: not resuming {state} ({why}): starting over", file=sys.stderr)
+        return None, 0
+    if not quiet:
+        print(f"resuming {state}: {done} of {key['passes']} passes done")
+    return total, done
+
+
 def cmd_reference(args) -> int:
     """Render a high-spp reference as the mean of passes with independent seeds;
     after every pass the running sum is saved (``OUT.state.npz``), so an
-    interrupted run resumes where it stopped."""
-    scene = load(args.scene)
+    interrupted run resumes where it stopped. A state of other settings, or
+    one that does not hold a valid partial sum, is not resumed: the run
+    starts over and says why."""
+    _check_counts(args, spp=False)
+    _in_range("--pass-spp", args.pass_spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
+    _in_range("--spp", args.spp, 1)
     if args.spp % args.pass_spp:
         raise ValueError(f"--spp ({args.spp}) must be a multiple of --pass-spp ({args.pass_spp})")
     passes = args.spp // args.pass_spp
+    _in_range("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
+    check_output(args.out, "--out", EXR)
     state = Path(str(args.out) + ".state.npz")
-    key = json.dumps(dict(scene=os.path.abspath(scene.path), size=args.size, max_depth=args.max_depth,
-                          sampler=args.sampler, pass_spp=args.pass_spp, seed=args.seed, filter=args.filter))
-    total, done = None, 0
-    if state.exists():
-        with np.load(state) as st:
-            if str(st["key"]) == key:
-                total, done = st["sum"], int(st["passes"])
-                if not args.quiet:
-                    print(f"resuming {state}: {done} of {passes} passes done")
+    if state.is_dir():
+        raise ValueError(f"{str(state)!r} (where pyoa reference keeps its running sum) is a directory; "
+                         "remove or rename it")
+    scene = load(args.scene)
+    p = _plan(scene, args, args.sampler, args.pass_spp)
+    _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
+    key = _reference_key(scene, args, p, passes)
+    text = json.dumps(key)
+    total, done = _resume(state, key, args.quiet)
     from tqdm.auto import tqdm
 
     for k in tqdm(range(done, passes), initial=done, total=passes, desc="reference passes", disable=args.quiet):
         res = render(scene, sampler=args.sampler, spp=args.pass_spp, seed=pass_seed(args.seed, k),
-                     **_size(args),
-                     max_depth=args.max_depth, filter=args.filter, backend=args.backend, shading=args.shading)
+                     **_size(args), max_depth=args.max_depth, filter=args.filter, first=args.first,
+                     backend=args.backend, shading=args.shading)
+        # a NaN pass would spoil every later pass's mean: stop at the first
+        check_finite(res.image, f"--out {args.out!r} not written: pass {k}")
         img = res.image.astype(np.float64)
         total = img if total is None else total + img
         with atomic_path(state) as tmp:
             with open(tmp, "wb") as fh:
-                np.savez(fh, sum=total, passes=k + 1, key=key)
+                np.savez(fh, sum=total, passes=k + 1, key=text)
     write_exr(args.out, (total / passes).astype(np.float32))
     state.unlink(missing_ok=True)
     if not args.quiet:

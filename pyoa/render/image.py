@@ -1,12 +1,26 @@
-"""Images in and out with OpenImageIO; every write is atomic; relative MSE."""
+"""Images in and out with OpenImageIO; every write is atomic; relative MSE.
+
+Writes refuse an image with a non-finite pixel (NaN or inf), and refuse an
+output path that cannot be written, naming the user's path (never the
+temporary file beside it). A reference image must hold linear radiance: a
+float or half image (EXR, HDR), not 8- or 16-bit integer data such as a PNG,
+which is sRGB-encoded display data.
+"""
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 
+from .. import atomic
 from ..atomic import atomic_path
+
+#: Output formats by extension (what pyoa writes: linear float EXR, 8-bit sRGB PNG).
+EXR, PNG = (".exr",), (".png",)
+#: Pixel formats of linear radiance (OpenImageIO base types).
+LINEAR_FORMATS = ("half", "float", "double")
 
 
 def _oiio():
@@ -17,21 +31,71 @@ def _oiio():
     return oiio
 
 
+def check_output(path, option: str, suffixes: tuple[str, ...]) -> None:
+    """Refuse (ValueError, one line naming ``option`` and ``path``) an image
+    output that could not be written at the end of a long job: a wrong
+    extension, a directory, a missing parent directory, one where no file can
+    be created, a format OpenImageIO cannot write."""
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise ValueError(f"{option} {str(path)!r}: the file name must end in {' or '.join(suffixes)}")
+    check_writable(path, option)
+    out = _oiio().ImageOutput.create(str(p))
+    if out is None:  # pragma: no cover - an OpenImageIO built without EXR or PNG
+        raise ValueError(f"{option} {str(path)!r}: OpenImageIO cannot write {p.suffix} files here")
+
+
+def check_writable(path, option: str) -> None:
+    """Refuse a ``path`` that :func:`pyoa.atomic.atomic_path` could not write
+    (see :func:`pyoa.atomic.check_writable`: a directory, a missing parent, a
+    place where no file can be created), the message led by ``option``."""
+    try:
+        atomic.check_writable(path)
+    except OSError as exc:
+        raise type(exc)(f"{option}: {exc}") from None
+
+
+def check_finite(image: np.ndarray, what: str) -> None:
+    """Refuse (ValueError) an image with NaN or inf pixels: the message starts
+    with ``what`` and gives their count and the first few (x, y)."""
+    bad = ~np.isfinite(image)
+    if bad.ndim == 3:
+        bad = bad.any(axis=2)
+    if bad.any():
+        ys, xs = np.nonzero(bad)
+        first = ", ".join(f"({x}, {y})" for x, y in zip(xs[:3].tolist(), ys[:3].tolist()))
+        raise ValueError(f"{what}: {len(xs)} of {bad.size} pixels are not finite (NaN or inf, e.g. radiance over "
+                         f"the float32 range), first at (x, y) {first}{', ...' if len(xs) > 3 else ''}")
+
+
 def _write(path, pixels: np.ndarray, fmt: str) -> None:
     oiio = _oiio()
     h, w, c = pixels.shape
+
+    def failed(message: str) -> str:
+        # OpenImageIO names the temporary file; the user knows only `path`
+        first = (message.strip().splitlines() or ["unknown error"])[0]
+        return f"OpenImageIO: {first.replace(str(tmp), str(path))}"
+
+    # atomic_path refuses a directory or a missing parent before the body, and
+    # re-raises an OSError of the body as "cannot write 'PATH': ..."
     with atomic_path(path) as tmp:
         out = oiio.ImageOutput.create(str(tmp))
         if out is None:
-            raise ValueError(f"OpenImageIO cannot write {str(path)!r}: {oiio.geterror()}")
+            raise ValueError(f"cannot write {str(path)!r}: {failed(oiio.geterror())}")
         spec = oiio.ImageSpec(w, h, c, fmt)
         if not (out.open(str(tmp), spec) and out.write_image(pixels) and out.close()):
-            raise OSError(f"writing {str(path)!r} failed: {out.geterror()}")
+            raise OSError(failed(out.geterror()))
 
 
 def write_exr(path: str | os.PathLike, image: np.ndarray) -> None:
-    """Write a linear float32 RGB image (``(H, W, 3)``) as OpenEXR, atomically."""
-    _write(path, np.ascontiguousarray(image, dtype=np.float32), "float")
+    """Write a linear float32 RGB image (``(H, W, 3)``) as OpenEXR, atomically.
+
+    A non-finite pixel, or one a float32 cannot hold, is refused (ValueError)."""
+    with np.errstate(over="ignore"):  # a value over the float32 range becomes inf, refused just below
+        pixels = np.ascontiguousarray(image, dtype=np.float32)
+    check_finite(pixels, f"{str(path)!r} not written")
+    _write(path, pixels, "float")
 
 
 def to_srgb8(image: np.ndarray) -> np.ndarray:
@@ -42,18 +106,39 @@ def to_srgb8(image: np.ndarray) -> np.ndarray:
 
 
 def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
-    """Write a linear RGB image as an 8-bit sRGB PNG, atomically."""
+    """Write a linear RGB image as an 8-bit sRGB PNG, atomically (a
+    non-finite pixel is refused, not drawn black)."""
+    check_finite(image, f"{str(path)!r} not written")
     _write(path, to_srgb8(image), "uint8")
+
+
+def _open(path):
+    oiio = _oiio()
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"no such image: {str(path)!r}")
+    if os.path.isdir(path):
+        raise ValueError(f"{str(path)!r} is a directory, not an image")
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        first = (oiio.geterror().strip().splitlines() or ["unknown format"])[0]
+        raise ValueError(f"OpenImageIO cannot read {str(path)!r}: {first}")
+    return inp
+
+
+def image_info(path: str | os.PathLike) -> tuple[int, int, int, str]:
+    """``(width, height, channels, pixel format)`` of an image file, from its
+    header only (nothing is decoded)."""
+    inp = _open(path)
+    try:
+        spec = inp.spec()
+        return spec.width, spec.height, spec.nchannels, str(spec.format)
+    finally:
+        inp.close()
 
 
 def read_image(path: str | os.PathLike) -> np.ndarray:
     """Read an image (EXR, PNG, ...) as float32 ``(H, W, channels)``."""
-    oiio = _oiio()
-    if not os.path.exists(path):
-        raise FileNotFoundError(f"no such image: {str(path)!r}")
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise ValueError(f"OpenImageIO cannot read {str(path)!r}: {oiio.geterror()}")
+    inp = _open(path)
     try:
         spec = inp.spec()
         pixels = inp.read_image("float")
@@ -62,6 +147,42 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
     if pixels is None:
         raise ValueError(f"reading {str(path)!r} failed")
     return np.asarray(pixels, dtype=np.float32).reshape(spec.height, spec.width, -1)
+
+
+def check_reference(path, option: str, width: int, height: int) -> None:
+    """Refuse (ValueError/FileNotFoundError) a reference image that is not
+    linear radiance of ``width`` x ``height`` with RGB channels, from its
+    header alone: checked before a render, not after it."""
+    w, h, c, fmt = image_info(path)
+    if fmt not in LINEAR_FORMATS:
+        raise ValueError(f"{option} {str(path)!r} holds {fmt} pixels (display-encoded, e.g. an sRGB PNG), not linear "
+                         "radiance; give a float or half image such as EXR or HDR (pyoa reference writes one)")
+    if c < 3:
+        raise ValueError(f"{option} {str(path)!r} has {c} channel{'s' if c != 1 else ''}; it needs RGB (3 or more)")
+    if (w, h) != (width, height):
+        raise ValueError(f"reference {str(path)!r} is {w} x {h}, the render is {width} x {height}; "
+                         f"render with --size {w} {h}")
+
+
+def read_reference(path, option: str, width: int, height: int) -> np.ndarray:
+    """A reference image as float32 ``(height, width, 3)``: checked as
+    :func:`check_reference`, and every pixel finite."""
+    check_reference(path, option, width, height)
+    ref = read_image(path)[..., :3]
+    bad = ~np.isfinite(ref).all(axis=2)
+    if bad.any():
+        y, x = (int(v[0]) for v in np.nonzero(bad))
+        raise ValueError(f"{option} {str(path)!r} has {int(bad.sum())} non-finite pixels (NaN or inf), first at "
+                         f"(x, y) ({x}, {y})")
+    return np.ascontiguousarray(ref)
+
+
+def check_crop(crop, width: int, height: int) -> None:
+    """Refuse (ValueError) a crop window ``(x, y, w, h)`` that is empty or not
+    inside a ``width`` x ``height`` image."""
+    x, y, w, h = crop
+    if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > width or y + h > height:
+        raise ValueError(f"crop {x} {y} {w} {h} does not fit in the {width} x {height} image")
 
 
 def rel_mse(image: np.ndarray, reference: np.ndarray, crop=None) -> float:
@@ -73,10 +194,8 @@ def rel_mse(image: np.ndarray, reference: np.ndarray, crop=None) -> float:
     if image.shape != reference.shape:
         raise ValueError(f"image {image.shape} and reference {reference.shape} differ in size")
     if crop is not None:
+        check_crop(crop, image.shape[1], image.shape[0])
         x, y, w, h = crop
-        H, W = image.shape[:2]
-        if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > W or y + h > H:
-            raise ValueError(f"crop {x} {y} {w} {h} does not fit in the {W} x {H} image")
         image, reference = image[y:y + h, x:x + w], reference[y:y + h, x:x + w]
     a, r = image.astype(np.float64), reference.astype(np.float64)
     return float(np.mean((a - r) ** 2 / (r**2 + 1e-2)))

@@ -24,6 +24,12 @@ the pixel, sample and depth).
 
 from __future__ import annotations
 
+from ..constructions import MAX_DIMS
+
+#: Longest path (segments) whose layout fits in a sampler's MAX_DIMS
+#: dimensions: pixel 2 + lens 2 + time 1 + 4 per vertex.
+MAX_DEPTH = (MAX_DIMS - 5) // 4 + 1
+
 
 class Layout:
     """The dimension layout of one render.
@@ -31,7 +37,7 @@ class Layout:
     Parameters
     ----------
     max_depth : int
-        Longest path in segments (>= 1).
+        Longest path in segments, in [1, MAX_DEPTH].
     mis : bool
         Whether the last vertex also takes a BSDF sample (multiple
         importance sampling of emitter hits).
@@ -44,8 +50,8 @@ class Layout:
     """
 
     def __init__(self, *, max_depth: int, mis: bool, lens: bool, time: bool, first=None):
-        if max_depth < 1:
-            raise ValueError(f"max_depth must be >= 1, got {max_depth}")
+        if not 1 <= max_depth <= MAX_DEPTH:  # checked before a loop over the vertices
+            raise ValueError(f"max_depth must be in [1, {MAX_DEPTH}], got {max_depth}")
         names = ["pixel.x", "pixel.y"]
         if lens:
             names += ["lens.u", "lens.v"]

@@ -9,6 +9,7 @@ The result does not depend on the batch size or the number of threads.
 
 from __future__ import annotations
 
+import numbers
 import os
 import time
 import warnings
@@ -17,12 +18,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..constructions import MAX_UINT32
+from ..samplers import ENV_MAX_BYTES, default_max_bytes, format_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
+from .camera import FILTERS
 from .integrator import Integrator, Stats
-from .layout import Layout
+from .layout import MAX_DEPTH, Layout
 
 #: Camera paths per batch (bounds the working set: ~1 KiB per path).
 BATCH_PATHS = 1 << 16
+#: Working memory of one camera path in flight, besides its row of sampler
+#: values: measured peaks are ~0.3 KiB (compiled shading) and ~1.1 KiB (NumPy
+#: shading, 46 dimensions, sampler row included), so 1 KiB plus 8 bytes per
+#: dimension (the float32 row and float64 copies of its columns) bounds both.
+PATH_BYTES = 1024
+#: Bytes of the image per pixel (float32 RGB) and of one batch's bookkeeping
+#: (its entry in the list of batches and the tuple in it).
+PIXEL_BYTES = 12
+BATCH_BYTES = 128
+#: Most pixels in one image: pixel indices are uint32 (the sampler's pixel seeds).
+MAX_PIXELS = MAX_UINT32 + 1
 #: Shading implementations: numba-compiled with Embree called from it (the
 #: default), or the NumPy reference.
 SHADINGS = ("numba", "numpy")
@@ -67,6 +82,103 @@ class RenderResult:
         return self.stats.rays / max(self.seconds, 1e-9)
 
 
+def _count(name: str, value, default: int | None = None, hi: int | None = None) -> int:
+    """``value`` as an int in ``[1, hi]``; None means ``default`` (the scene's).
+
+    Zero is refused rather than read as "the scene's": a size of 0 is a
+    mistake, and only None (not given) means the default."""
+    if value is None and default is not None:
+        return default
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        also = " or None (the scene's)" if default is not None else ""
+        raise TypeError(f"{name} must be an integer{also}, got {type(value).__name__} {value!r}")
+    value = int(value)
+    if value < 1 or (hi is not None and value > hi):
+        rng = f"in [1, {hi}]" if hi is not None else ">= 1"
+        raise ValueError(f"{name} must be {rng}, got {value}")
+    return value
+
+
+def resolve_max_bytes(max_bytes: int | str | None) -> int:
+    """The memory limit in bytes: ``max_bytes`` (any form
+    :func:`pyoa.samplers.parse_bytes` accepts: bytes, ``"4G"``, a fraction of RAM), else ``$PYOA_MAX_BYTES``, else half of the physical memory (the
+    samplers' limit, :func:`pyoa.samplers.default_max_bytes`)."""
+    return default_max_bytes() if max_bytes is None else parse_bytes(max_bytes)
+
+
+def render_bytes(width: int, height: int, spp: int, dims: int, *, batch_paths: int = BATCH_PATHS,
+                 threads: int | None = None) -> int:
+    """Bytes :func:`render` needs at its peak: the image, the list of batches,
+    and each worker's batch of camera paths in flight (every sample of a pixel
+    is in one batch, so a batch holds at least ``spp`` paths)."""
+    n_pixels = width * height
+    per_batch = min(max(1, batch_paths // spp), n_pixels)
+    n_batches = -(-n_pixels // per_batch)
+    workers = max(1, min(threads or os.cpu_count() or 1, n_batches))
+    in_flight = workers * per_batch * spp * (PATH_BYTES + 8 * dims)
+    return n_pixels * PIXEL_BYTES + n_batches * BATCH_BYTES + in_flight
+
+
+def check_memory(nbytes: int, what: str, limit: int) -> None:
+    """Refuse (ValueError) a job that needs more than ``limit`` bytes, before
+    anything is allocated."""
+    if nbytes > limit:
+        raise ValueError(f"{what} needs {format_bytes(nbytes)}, over the memory limit of {format_bytes(limit)}; "
+                         f"render fewer pixels or samples, or raise the limit with max_bytes= or ${ENV_MAX_BYTES}")
+
+
+def image_size(scene, width: int | None = None, height: int | None = None,
+               max_bytes: int | str | None = None) -> tuple[int, int]:
+    """``(width, height)`` of a render of ``scene``: the given ones (integers
+    >= 1) or the scene's film size, whose image fits in ``max_bytes`` (see
+    :func:`resolve_max_bytes`) and has at most ``MAX_PIXELS`` pixels."""
+    width = _count("width", width, scene.width)
+    height = _count("height", height, scene.height)
+    # the image alone first: a film of 1e9 x 1e9 is refused before the
+    # sampler or the layout is even built
+    check_memory(width * height * PIXEL_BYTES, f"a {width} x {height} image", resolve_max_bytes(max_bytes))
+    if width * height > MAX_PIXELS:
+        raise ValueError(f"image size {width} x {height} has {width * height} pixels; at most {MAX_PIXELS} "
+                         "(pixel indices are uint32)")
+    return width, height
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A validated render: everything :func:`render` checks before it allocates."""
+
+    width: int
+    height: int
+    layout: Layout
+    sampler: object  # pyoa.samplers.Sampler
+    nbytes: int
+    max_bytes: int
+
+
+def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
+         height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
+         backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
+         max_bytes: int | str | None = None) -> Plan:
+    """Check the arguments of :func:`render` (same meanings) and the memory it
+    needs, without rendering: every error a render can raise on its arguments
+    is raised here, before anything large is allocated."""
+    limit = resolve_max_bytes(max_bytes)
+    width, height = image_size(scene, width, height, limit)
+    depth = _count("max_depth", max_depth, scene.max_depth, MAX_DEPTH)
+    if filter not in FILTERS:
+        raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
+    batch_paths = _count("batch_paths", batch_paths)
+    if threads is not None:
+        threads = _count("threads", threads)
+    cam = scene.camera
+    layout = Layout(max_depth=depth, mis=scene.mis, lens=cam.aperture > 0,
+                    time=bool(np.any(np.asarray(cam.motion) != 0)), first=first)
+    smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend, max_bytes=limit)
+    nbytes = render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
+    check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit)
+    return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit)
+
+
 class ShadingFallbackWarning(RuntimeWarning):
     """The compiled shading was not usable and the NumPy reference rendered instead."""
 
@@ -87,7 +199,7 @@ def _warn_fallback(exc: BaseException) -> None:
 def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
            height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
            backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
-           progress: bool = False, shading: str | None = None) -> RenderResult:
+           progress: bool = False, shading: str | None = None, max_bytes: int | str | None = None) -> RenderResult:
     """Render ``scene`` (a :class:`pyoa.render.scene.Scene`) with ``spp`` samples per pixel.
 
     Parameters
@@ -98,7 +210,8 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     seed : int
         User seed of the sampler (uint32).
     width, height, max_depth : int, optional
-        Override the scene's film size and path length (segments, as Mitsuba).
+        Override the scene's film size and path length (segments, as Mitsuba);
+        integers >= 1 (None: the scene's; 0 is refused, not read as None).
     filter : {"box", "gaussian"}
         Pixel filter (see :class:`.integrator.Integrator`).
     first : sequence of str, optional
@@ -118,18 +231,24 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         (:mod:`pyoa.render.integrator`). Default ``$PYOA_SHADING``, else numba.
         Both estimate the same image; each gives the same bits for any batch
         size and thread count.
+    max_bytes : int or str, optional
+        Memory limit (default ``$PYOA_MAX_BYTES``, else half of the RAM, as
+        the samplers'): a render that would need more (:func:`render_bytes`)
+        is refused with a ValueError before anything is allocated.
+
+    Raises
+    ------
+    ValueError, TypeError
+        Invalid arguments or a render over the memory limit, all checked by
+        :func:`plan` before the first sample.
     """
     explicit = shading is not None
     shading = resolve_shading(shading)
-    width = int(width or scene.width)
-    height = int(height or scene.height)
-    if width < 1 or height < 1:
-        raise ValueError(f"image size must be positive, got {width} x {height}")
-    depth = int(max_depth if max_depth is not None else scene.max_depth)
-    cam = scene.camera
-    layout = Layout(max_depth=depth, mis=scene.mis, lens=cam.aperture > 0,
-                    time=bool(np.any(np.asarray(cam.motion) != 0)), first=first)
-    smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend)
+    p = plan(scene, sampler=sampler, spp=spp, seed=seed, width=width, height=height, max_depth=max_depth,
+             filter=filter, first=first, backend=backend, batch_paths=batch_paths, threads=threads,
+             max_bytes=max_bytes)
+    width, height, layout, smp = p.width, p.height, p.layout, p.sampler
+    spp, seed = smp.spp, smp.seed
     integ = None
     if shading == "numba":
         try:

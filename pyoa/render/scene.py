@@ -30,7 +30,7 @@ Conventions are Mitsuba's:
   ``cross(v1 - v0, v2 - v0)`` of its world-space vertices; where
   ``det(to_world[:3, :3]) < 0`` the winding of every triangle is reversed so
   that normals keep pointing to the front (outwards).
-* ``emission`` (RGB radiance, >= 0) turns a shape into an area light that emits
+* ``emission`` (RGB radiance, in [0, 3.4e38], what a float32 image can hold) turns a shape into an area light that emits
   on its front side only. A scene needs at least one emitter.
 * ``camera.fov`` is in degrees along the smaller image axis; ``aperture`` is
   the thin-lens radius (0: pinhole); ``focus_distance`` > 0; ``motion`` is a
@@ -63,6 +63,7 @@ from pathlib import Path
 import numpy as np
 
 from pyoa.render.bsdf import Materials
+from pyoa.render.layout import MAX_DEPTH
 
 __all__ = ["Camera", "Scene", "SceneError", "UnknownSceneError", "load", "bundled", "rectangle", "cube"]
 
@@ -156,6 +157,28 @@ def cube() -> np.ndarray:
 # -- validation helpers -----------------------------------------------------------
 
 
+#: Largest value a float32 image holds (emission, world coordinates).
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+#: Longest integer literal read from a scene file (Python's own limit on
+#: int-from-string conversion is 4300 digits; no field needs more than a few).
+MAX_INT_DIGITS = 100
+
+
+class _HugeInt:
+    """An integer literal too long to convert (see ``MAX_INT_DIGITS``): kept as
+    text so that the field check holding it names the file and field."""
+
+    def __init__(self, text: str):
+        self.digits = len(text.lstrip("-"))
+
+    def __repr__(self) -> str:
+        return f"an integer of {self.digits} digits"
+
+
+def _parse_int(text: str):
+    return int(text) if len(text) <= MAX_INT_DIGITS else _HugeInt(text)
+
+
 class _Ctx:
     """Formats error messages as ``file: field: problem``."""
 
@@ -169,8 +192,8 @@ class _Ctx:
 def _show(value) -> str:
     try:
         s = json.dumps(value)
-    except (TypeError, ValueError):
-        s = repr(value)
+    except (TypeError, ValueError, RecursionError):  # a _HugeInt, or deeply nested lists
+        s = repr(value) if not isinstance(value, (list, dict)) else type(value).__name__
     return s if len(s) <= 60 else s[:57] + "..."
 
 
@@ -210,12 +233,15 @@ def _number(ctx, where, v, lo=-math.inf, hi=math.inf, lo_open=False, hi_open=Fal
     return float(v)
 
 
-def _integer(ctx, where, v, lo: int) -> int:
-    if isinstance(v, bool) or not (isinstance(v, int) or (isinstance(v, float) and v.is_integer())):
-        raise ctx.error(where, f"expected an integer >= {lo}, got {_show(v)}")
-    if v < lo:
-        raise ctx.error(where, f"expected an integer >= {lo}, got {_show(v)}")
-    return int(v)
+def _integer(ctx, where, v, lo: int, hi: int | None = None) -> int:
+    """An integer literal in [lo, hi]; a float (even 256.0 or 1e9) is refused:
+    JSON writes counts without a fraction or exponent."""
+    want = f"an integer >= {lo}" if hi is None else f"an integer in [{lo}, {hi}]"
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise ctx.error(where, f"expected {want}, got {_show(v)}")
+    if v < lo or (hi is not None and v > hi):
+        raise ctx.error(where, f"expected {want}, got {_show(v)}")
+    return v
 
 
 def _boolean(ctx, where, v) -> bool:
@@ -253,7 +279,8 @@ def _matrix(ctx, where, v) -> np.ndarray:
     m[3] = [0, 0, 0, 1]
     a = m[:3, :3]
     scale = np.abs(a).max()
-    if scale == 0 or abs(np.linalg.det(a)) <= 1e-12 * scale**3:
+    # det of the matrix scaled to entries <= 1: scale**3 would overflow for large entries
+    if scale == 0 or abs(np.linalg.det(a / scale)) <= 1e-12:
         raise ctx.error(where, "singular matrix (det of the upper-left 3x3 is 0)")
     return m
 
@@ -308,9 +335,12 @@ def _parse(path: Path, ctx: _Ctx) -> dict:
     except UnicodeDecodeError as e:
         raise ctx.error("", f"not UTF-8 text ({e})") from None
     try:
-        data = json.loads(text, object_pairs_hook=_no_duplicates(ctx), parse_constant=_reject_constant(ctx))
+        data = json.loads(text, object_pairs_hook=_no_duplicates(ctx), parse_constant=_reject_constant(ctx),
+                          parse_int=_parse_int)
     except json.JSONDecodeError as e:
         raise ctx.error("", f"invalid JSON at line {e.lineno}, column {e.colno}: {e.msg}") from None
+    except RecursionError:  # the parser recurses once per nested list or object
+        raise ctx.error("", "invalid scene: lists or objects nested too deeply") from None
     if not isinstance(data, dict):
         raise ctx.error("", f"expected a JSON object at the top level, got {type(data).__name__}")
     return data
@@ -420,8 +450,12 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path):
             raise ctx.error(f"{where}.material", f"unknown material {name!r}; valid: {valid_mats}")
         emission = np.zeros(3)
         if "emission" in s:
-            emission = _vector(ctx, f"{where}.emission", s["emission"], lo=0)
+            # a larger radiance would be inf in the float32 image
+            emission = _vector(ctx, f"{where}.emission", s["emission"], lo=0, hi=FLOAT32_MAX)
         world = _transform(local, m)
+        if not np.all(np.abs(world) <= FLOAT32_MAX):  # triangles are stored (and traced) as float32
+            field_ = f"{where}.to_world" if "to_world" in s else f"{where}.file"
+            raise ctx.error(field_, f"vertices beyond the float32 range (|x| <= {FLOAT32_MAX:.4g}) in world space")
         cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
         area2 = np.linalg.norm(cross, axis=1)
         keep = area2 > 1e-12 * max(1.0, float(np.abs(world).max())) ** 2
@@ -452,7 +486,7 @@ def _load_file(path: Path) -> Scene:
     height = _integer(ctx, "film.height", film.get("height", 256), 1)
     integ = data.get("integrator", {})
     _check_keys(ctx, "integrator", integ, _INTEGRATOR)
-    max_depth = _integer(ctx, "integrator.max_depth", integ.get("max_depth", 5), 1)
+    max_depth = _integer(ctx, "integrator.max_depth", integ.get("max_depth", 5), 1, MAX_DEPTH)
     mis = _boolean(ctx, "integrator.mis", integ.get("mis", True))
     materials, ids = _materials(ctx, data["materials"])
     world, material, emission, owner = _shapes(ctx, data["shapes"], ids, path.parent)

@@ -535,7 +535,7 @@ def test_render_rejects_bad_arguments(cornell):
         render(cornell, spp=4, width=4, height=4, filter="tent")
     with pytest.raises(ValueError, match="max_depth"):
         render(cornell, spp=4, width=4, height=4, max_depth=0)
-    with pytest.raises(ValueError, match="size"):
+    with pytest.raises(ValueError, match=r"width must be >= 1, got -1"):
         render(cornell, spp=4, width=-1, height=4)
 
 
