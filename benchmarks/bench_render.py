@@ -58,7 +58,7 @@ sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared w
 import numpy as np  # noqa: E402
 
 import peers  # noqa: E402
-from common import loadavg, log, machine, machine_lines, timed, write_text  # noqa: E402
+from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, timed, write_text  # noqa: E402
 from pyoa.render.render import BATCH_PATHS, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
@@ -235,16 +235,10 @@ def time_renders(scene, args, shading: str) -> dict:
 # ---------------------------------------------------------------------------
 # peak memory, in a fresh process per render
 
-_MEMORY_CHILD = r"""
+_MEMORY_CHILD = MEMORY_CHILD_HELPERS + r"""
 import json, sys
 from pyoa.render.render import render
 from pyoa.render.scene import load
-
-def status_kib(key):
-    with open("/proc/self/status") as fh:
-        for line in fh:
-            if line.startswith(key + ":"):
-                return int(line.split()[1])
 
 name, sampler, shading = sys.argv[1:4]
 spp, w, h, depth, batch = (int(v) if v != "None" else None for v in sys.argv[4:9])
@@ -252,8 +246,8 @@ scene = load(name)
 # warm-up on one pixel: builds, caches and imports, but no batch-sized heap left behind in the baseline
 render(scene, sampler=sampler, spp=spp, width=1, height=1, max_depth=depth, shading=shading, batch_paths=batch)
 base = status_kib("VmRSS")
-with open("/proc/self/clear_refs", "w") as fh:  # VmHWM := VmRSS (Linux >= 4.0): the peak is the render's own
-    fh.write("5")
+if not reset_peak():  # VmHWM := VmRSS: the peak is the render's own
+    raise SystemExit("cannot reset VmHWM (/proc/self/clear_refs): no peak of the render alone")
 res = render(scene, sampler=sampler, spp=spp, width=w, height=h, max_depth=depth, shading=shading, batch_paths=batch)
 print(json.dumps({"status": "ok", "baseline_kib": base, "peak_kib": status_kib("VmHWM"), "dims": res.dims,
                   "shading": res.shading}))

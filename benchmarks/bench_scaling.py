@@ -120,7 +120,7 @@ from bench_generate import (  # noqa: E402  (benchmarks/ is on sys.path above)
     _opencl_details,
     summarize,
 )
-from common import loadavg, log, machine, machine_lines, write_text  # noqa: E402
+from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
 
 try:
     import pyoa
@@ -237,17 +237,10 @@ def run_sweep(sweep: str, backends: list[str], args) -> list[dict]:
 # ---------------------------------------------------------------------------
 # memory, in a fresh subprocess per backend
 
-_MEMORY_CHILD = r"""
+_MEMORY_CHILD = MEMORY_CHILD_HELPERS + r"""
 import json, resource, sys, time, warnings
 import numpy as np
 import pyoa
-
-def status_kib(key):
-    with open("/proc/self/status") as fh:
-        for line in fh:
-            if line.startswith(key + ":"):
-                return int(line.split()[1])
-    return None
 
 def maxrss_kib():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
@@ -266,12 +259,7 @@ except Exception:
 res = {"status": "ok", "device": smp.device, "chunk_values": chunk_values,
        "baseline_maxrss_kib": maxrss_kib(), "baseline_hwm_kib": status_kib("VmHWM"),
        "baseline_rss_kib": status_kib("VmRSS")}
-try:  # reset VmHWM to the current RSS (Linux >= 4.0), so the peak is the big call's own
-    with open("/proc/self/clear_refs", "w") as fh:
-        fh.write("5")
-    res["hwm_reset"] = status_kib("VmHWM") <= res["baseline_rss_kib"] + 1024
-except OSError:
-    res["hwm_reset"] = False
+res["hwm_reset"] = reset_peak()  # so the peak is the big call's own
 t0 = time.perf_counter()
 x = smp.generate(pixels=range(pixels))
 res.update(seconds=time.perf_counter() - t0, output_bytes=int(x.nbytes), peak_maxrss_kib=maxrss_kib(),

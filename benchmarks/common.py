@@ -149,6 +149,30 @@ def timed(fn: Callable[[], object], repeats: int, *, warmup: bool = True, label:
 
 
 
+#: Helpers of the benchmarks' memory children (fresh processes, so the code
+#: travels as source, prepended to each child's script): ``status_kib(key)``
+#: reads ``VmRSS``/``VmHWM`` from ``/proc/self/status``; ``reset_peak()`` sets
+#: ``VmHWM`` to the current RSS (Linux >= 4.0), so the peak measured after it
+#: is the measured call's own, and says whether it could.
+MEMORY_CHILD_HELPERS = r"""
+def status_kib(key):
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(key + ":"):
+                return int(line.split()[1])
+    return None
+
+def reset_peak():
+    rss = status_kib("VmRSS")
+    try:
+        with open("/proc/self/clear_refs", "w") as fh:
+            fh.write("5")
+    except OSError:
+        return False
+    return status_kib("VmHWM") <= rss + 1024
+"""
+
+
 # ---------------------------------------------------------------------------
 # reports
 

@@ -45,15 +45,16 @@ MAX_DIMS = 2**20
 MAX_UINT32 = 2**32 - 1
 
 
-def check_int(name: str, value, lo: int | None = None, hi: int | None = None) -> int:
+def check_int(name: str, value, lo: int | None = None, hi: int | None = None, why: str = "") -> int:
     """``value`` as a Python int in ``[lo, hi]``; bools and floats are refused
-    (TypeError), out-of-range values too (ValueError), each naming ``name``."""
+    (TypeError), out-of-range values too (ValueError), each naming ``name``;
+    ``why`` (e.g. ``" (a uint32)"``) follows the range in the message."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
     value = int(value)
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         rng = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
-        raise ValueError(f"{name} must be {rng}, got {value}")
+        raise ValueError(f"{name} must be {rng}{why}, got {value}")
     return value
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from .. import constructions
 from ..atomic import atomic_path
 from ..cli import _rate
-from ..constructions import MAX_SPP, MAX_UINT32
+from ..constructions import MAX_SPP, MAX_UINT32, check_int
 from .image import (EXR, PNG, check_crop, check_finite, check_output, check_writable, read_reference, rel_mse,
                     write_exr, write_png)
 from .layout import MAX_DEPTH
@@ -37,23 +37,17 @@ def _size(args) -> dict:
     return dict(width=w, height=h)
 
 
-def _in_range(option: str, value: int, lo: int, hi: int | None = None, why: str = "") -> None:
-    if value < lo or (hi is not None and value > hi):
-        rng = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
-        raise ValueError(f"{option} must be {rng}{why}, got {value}")
-
-
 def _check_counts(args, spp: bool = True) -> None:
     """Refuse out-of-range counts of the options every command shares, before
     anything is loaded or rendered (0 is refused, never read as a default)."""
     if spp:
-        _in_range("--spp", args.spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
-    _in_range("--seed", args.seed, 0, MAX_UINT32, " (a uint32)")
+        check_int("--spp", args.spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
+    check_int("--seed", args.seed, 0, MAX_UINT32, " (a uint32)")
     if args.max_depth is not None:
-        _in_range("--max-depth", args.max_depth, 1, MAX_DEPTH)
+        check_int("--max-depth", args.max_depth, 1, MAX_DEPTH)
     if args.size is not None:
         for name, v in zip(("W", "H"), args.size):
-            _in_range(f"--size {name}", v, 1)
+            check_int(f"--size {name}", v, 1)
 
 
 def _check_job_memory(p, what: str) -> None:
@@ -322,12 +316,12 @@ def cmd_reference(args) -> int:
     one that does not hold a valid partial sum, is not resumed: the run
     starts over and says why."""
     _check_counts(args, spp=False)
-    _in_range("--pass-spp", args.pass_spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
-    _in_range("--spp", args.spp, 1)
+    check_int("--pass-spp", args.pass_spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
+    check_int("--spp", args.spp, 1)
     if args.spp % args.pass_spp:
         raise ValueError(f"--spp ({args.spp}) must be a multiple of --pass-spp ({args.pass_spp})")
     passes = args.spp // args.pass_spp
-    _in_range("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
+    check_int("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
     check_output(args.out, "--out", EXR)
     state = Path(str(args.out) + ".state.npz")
     if state.is_dir():

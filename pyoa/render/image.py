@@ -169,11 +169,7 @@ def read_reference(path, option: str, width: int, height: int) -> np.ndarray:
     :func:`check_reference`, and every pixel finite."""
     check_reference(path, option, width, height)
     ref = read_image(path)[..., :3]
-    bad = ~np.isfinite(ref).all(axis=2)
-    if bad.any():
-        y, x = (int(v[0]) for v in np.nonzero(bad))
-        raise ValueError(f"{option} {str(path)!r} has {int(bad.sum())} non-finite pixels (NaN or inf), first at "
-                         f"(x, y) ({x}, {y})")
+    check_finite(ref, f"{option} {str(path)!r}")
     return np.ascontiguousarray(ref)
 
 

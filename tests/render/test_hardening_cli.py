@@ -11,6 +11,7 @@ import re
 import sys
 
 import numpy as np
+import OpenImageIO as oiio
 import pytest
 
 from pyoa.render.image import write_exr, write_png
@@ -153,6 +154,18 @@ def test_png_reference_is_refused(pyoa, tmp_path, old_exr):
         refused(res, command, r"--reference '.*ref\.png' holds uint8 pixels .*not linear radiance; give a float "
                               r"or half image such as EXR")
     assert old_exr.read_bytes() == OLD and sorted(os.listdir(tmp_path)) == ["old.exr", "ref.png"]
+
+
+def test_non_finite_reference_is_refused(pyoa, tmp_path, old_exr):
+    """A reference with a NaN pixel would make every relMSE NaN: refused before rendering, naming the pixel."""
+    image = np.ones((8, 8, 3), np.float32)
+    image[2, 5, 1] = np.nan
+    ref = tmp_path / "ref.exr"
+    out = oiio.ImageOutput.create(str(ref))  # pyoa's own write_exr refuses NaN: write it with OpenImageIO
+    assert out.open(str(ref), oiio.ImageSpec(8, 8, 3, "float")) and out.write_image(image) and out.close()
+    res = pyoa("render", "cornell", "--size", "8", "8", "--spp", "4", "--out", old_exr, "--reference", ref, "-q")
+    refused(res, "render", r"--reference '.*ref\.exr': 1 of 64 pixels are not finite .*first at \(x, y\) \(5, 2\)$")
+    assert old_exr.read_bytes() == OLD
 
 
 @pytest.mark.parametrize("argv, pattern", [
