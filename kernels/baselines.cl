@@ -2,17 +2,44 @@
  * the mathematics and references). Values of random, sobol02, halton and
  * sobol are k * 2^-24 with k a 24-bit integer: exact in float, no rounding. */
 
-#define RANDOM_KEY  0xc2b2ae35u
-#define PAD_KEY     0x85ebca6bu
-#define HALTON_KEY  0x27d4eb2fu
-#define DIGIT_KEY   0x165667b1u
-#define SOBOL_KEY   0x9e3779b9u
-#define OWEN_KEY    0xcc9e2d51u
-#define SHUFFLE_KEY 0x51633e2du
-#define SUBX_KEY    0x68bc21ebu
-#define SUBY_KEY    0x02e5be93u
-#define JITX_KEY    0x967a889bu
-#define JITY_KEY    0x368cc8b7u
+/* The *_KEY constants (RANDOM_KEY, PAD_KEY, HALTON_KEY, DIGIT_KEY, SOBOL_KEY,
+ * OWEN_KEY, SHUFFLE_KEY, SUBX_KEY, SUBY_KEY, JITX_KEY, JITY_KEY) are not
+ * defined here: pyoa/_opencl/program.py's defines() passes them as -D build
+ * options (uint literals), generated from the constants of the same names in
+ * pyoa/reference/baselines.py, their only definition. */
+#ifndef RANDOM_KEY
+#error "RANDOM_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef PAD_KEY
+#error "PAD_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef HALTON_KEY
+#error "HALTON_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef DIGIT_KEY
+#error "DIGIT_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef SOBOL_KEY
+#error "SOBOL_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef OWEN_KEY
+#error "OWEN_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef SHUFFLE_KEY
+#error "SHUFFLE_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef SUBX_KEY
+#error "SUBX_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef SUBY_KEY
+#error "SUBY_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef JITX_KEY
+#error "JITX_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef JITY_KEY
+#error "JITY_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
 
 float unit24(uint h) { return convert_float(h >> 8) * 0x1.0p-24f; }
 
@@ -67,8 +94,8 @@ float sample_jittered2d(uint i, uint j, uint m, uint dims, uint p, float J)
     uint k = permute(i, N, q * SHUFFLE_KEY);
     bool even = (j & 1u) == 0u;
     float jit = jitter_value(randfloat(k, q * (even ? JITX_KEY : JITY_KEY)), J);
-    if (even && j + 1u == dims) return sample_value(k, 0.0f, jit, 1u, N);  /* a lone last dimension */
-    return sample_value(even ? k % m : k / m, 0.0f, jit, 1u, m);
+    if (even && j + 1u == dims) return sample_value(k, 0u, jit, 1u, N);  /* a lone last dimension */
+    return sample_value(even ? k % m : k / m, 0u, jit, 1u, m);
 }
 
 float sample_cmj2d(uint i, uint j, uint m, uint n, uint p, float J)
@@ -78,9 +105,9 @@ float sample_cmj2d(uint i, uint j, uint m, uint n, uint p, float J)
     uint sx = permute(k % m, m, q * SUBX_KEY);
     if ((j & 1u) == 0u) {
         uint sy = permute(k / m, n, q * SUBY_KEY);
-        return sample_value(k % m, convert_float(sy), jitter_value(randfloat(k, q * JITX_KEY), J), n, m);
+        return sample_value(k % m, sy, jitter_value(randfloat(k, q * JITX_KEY), J), n, m);
     }
-    return sample_value(k / m, convert_float(sx), jitter_value(randfloat(k, q * JITY_KEY), J), m, n);
+    return sample_value(k / m, sx, jitter_value(randfloat(k, q * JITY_KEY), J), m, n);
 }
 
 float sample_sobol02(uint i, uint j, uint log2n, uint p, __global const uint *directions)

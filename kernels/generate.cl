@@ -7,7 +7,7 @@
  * - tables + tables_finish + generate_cells ('cmj' and 'centered', every
  *   construction): the permutations that do not depend on the sample are
  *   computed once per (pixel, dimension) into a table, then a loop-free
- *   kernel that PoCL can vectorize reads them (POCL-NOTES.md: a cycle-walking
+ *   kernel that PoCL can vectorize reads them (docs/performance.md, lessons for PoCL: a cycle-walking
  *   loop in a kernel keeps PoCL scalar). Table entry layout per (pixel,
  *   dimension), E entries: [0, s) stratum permutation, [s, s + M)
  *   sub-stratum permutation ('cmj' only), [E - 1] the jitter seed P3.
@@ -148,29 +148,36 @@ __kernel void tables_finish(__global uint *restrict tab,
  * (A_ij and the sub-stratum index u of every requested dimension and sample)
  * do not depend on the pixel; the host computes them once per launch
  * (pyoa._numpy.oa.cells), laid out [d][k], so that every construction shares
- * this one straight-line kernel and its loads along k are contiguous.
- * 'centered' passes cell_u = 0 and reads (and ignores) slot s. */
-__kernel void generate_cells(__global float *restrict out,
-                             const uint out0,
-                             __global const uint *restrict tab,
-                             __global const uint *restrict cell_a,
-                             __global const uint *restrict cell_u,
-                             __global const uint *restrict isamp,
-                             const uint n_k,
-                             const uint n_dims,
-                             const uint E,
-                             const uint Es,
-                             const uint s,
-                             const uint M,
-                             const uint offset,
-                             const float J)
-{
-    uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);
-    uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;
-    uint c = d * n_k + k;
-    float sub = (offset == OFFSET_CMJ) ? convert_float(tab[base + s + cell_u[c]]) : 0.5f * convert_float(M - 1u);
-    out[rect_index(out0, k, pl, d, n_k, n_dims)] = oa_value(isamp[k], tab[base + cell_a[c]], sub, tab[base + E - 1u], M, s, J);
+ * these straight-line kernels and its loads along k are contiguous. */
+#define GENERATE_CELLS(NAME, VALUE)                                                     \
+__kernel void NAME(__global float *restrict out,                                        \
+                   const uint out0,                                                     \
+                   __global const uint *restrict tab,                                   \
+                   __global const uint *restrict cell_a,                                \
+                   __global const uint *restrict cell_u,                                \
+                   __global const uint *restrict isamp,                                 \
+                   const uint n_k,                                                      \
+                   const uint n_dims,                                                   \
+                   const uint E,                                                        \
+                   const uint Es,                                                       \
+                   const uint s,                                                        \
+                   const uint M,                                                        \
+                   const float J)                                                       \
+{                                                                                       \
+    uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                      \
+    uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;                             \
+    uint c = d * n_k + k;                                                               \
+    uint stratum = tab[base + cell_a[c]];                                               \
+    float jit = jitter_value(randfloat(isamp[k], tab[base + E - 1u]), J);               \
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = VALUE;                               \
 }
+
+/* One kernel per offset of the table path rather than one with an offset
+ * argument: a select between the two value paths, even on that uniform
+ * argument, kept PoCL from vectorizing (0.20 instead of 0.55 G values/s,
+ * docs/performance.md). 'centered' passes cell_u = 0 and never reads it. */
+GENERATE_CELLS(generate_cells, sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s))
+GENERATE_CELLS(generate_cells_centered, centered_value(stratum, jit, M, s))
 
 /* The comparison samplers: one kernel each, one work-item per value, over a
  * rectangle like `generate`. a and b are the sampler's shape arguments (Baseline.shape_args), `table` its

@@ -1,8 +1,8 @@
-/* Orthogonal-array samplers of SPEC section 5 (mirrors pyoa/reference/oa.py).
+/* Orthogonal-array samplers of docs/spec.md section 5 (mirrors pyoa/reference/oa.py).
  * Offset codes OFFSET_* come from pyoa.constructions as -D build options.
  *
  * Each sampler is split into the pieces the bulk kernels of generate.cl
- * reuse: the column key (block seed times column + 1, SPEC sections 3 and 6),
+ * reuse: the column key (block seed times column + 1, docs/spec.md sections 3 and 6),
  * the integer cell of the array, and the final value. */
 
 /* q = block_seed(p, j / dmax) * (j % dmax + 1): the three dimension seeds are
@@ -15,7 +15,7 @@ uint column_key(uint p, uint j, uint dmax)
 /* Bose over GF(s): A_ij of column j (< s+1) and A_ik of its partner column
  * k. The column-0/1/other choice is written with bit masks, not a ?: chain,
  * which LLVM turns into a switch that keeps PoCL from vectorizing
- * (POCL-NOTES.md); multipliers of columns 0 and 1 are clamped to 0 so that
+ * (docs/performance.md, lessons for PoCL); multipliers of columns 0 and 1 are clamped to 0 so that
  * table lookups stay in range for the lanes the masks discard. */
 void bose_cell(uint i, uint j, uint s, __global const ushort *gf, uint tabled, uint *aij, uint *aik)
 {
@@ -48,19 +48,20 @@ void cmjnd_cell(uint i, uint s, uint sj, uint *aij, uint *v)
     *v = i % sj + (i / (sj * s)) * sj;
 }
 
-/* x from the stratum, the sub-stratum (as float) and the jitter seed. */
-float oa_value(uint i, uint stratum, float sub, uint P3, uint M, uint s, float J)
+/* x from the stratum, the integer sub-stratum and the jitter seed. */
+float oa_value(uint i, uint stratum, uint sub, uint P3, uint M, uint s, float J, uint offset)
 {
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s);
+    float jit = jitter_value(randfloat(i, P3), J);
+    return (offset == OFFSET_CENTERED) ? centered_value(stratum, jit, M, s) : sample_value(stratum, sub, jit, M, s);
 }
 
 /* sub-stratum of the offset styles that hash per cell ('j', 'mj') or per
- * column ('cmj'); 'centered' is (M-1)/2. cell_key is the 'j' seed factor. */
-float offset_sub(uint offset, uint u, uint M, uint cell_key, uint aij, uint P2)
+ * column ('cmj'); 'centered' does not use it (see centered_value). cell_key
+ * is the 'j' seed factor. */
+uint offset_sub(uint offset, uint u, uint M, uint cell_key, uint aij, uint P2)
 {
-    if (offset == OFFSET_CENTERED) return 0.5f * convert_float(M - 1u);
     uint seed = (offset == OFFSET_J) ? cell_key * P2 : (offset == OFFSET_MJ) ? (aij + 1u) * P2 : P2;
-    return convert_float(permute(u, M, seed));
+    return (offset == OFFSET_CENTERED) ? 0u : permute(u, M, seed);
 }
 
 float bose(uint i, uint j, uint s, uint p, uint offset, float J, __global const ushort *gf, uint tabled)
@@ -69,8 +70,8 @@ float bose(uint i, uint j, uint s, uint p, uint offset, float J, __global const 
     uint aij, aik;
     bose_cell(i, j % (s + 1u), s, gf, tabled, &aij, &aik);
     uint stratum = permute(aij, s, q * STRATUM_KEY);
-    float sub = offset_sub(offset, aik, s, aik * s + aij + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, s, s, J);
+    uint sub = offset_sub(offset, aik, s, aik * s + aij + 1u, aij, q * SUBSTRATUM_KEY);
+    return oa_value(i, stratum, sub, q * JITTER_KEY, s, s, J, offset);
 }
 
 /* pow_u(s, e) = s^e; every use stays below 2^24. */
@@ -88,8 +89,8 @@ float cmjnd(uint i, uint j, uint s, uint t, uint p, uint offset, float J)
     uint aij, v;
     cmjnd_cell(i, s, pow_u(s, j % t), &aij, &v);
     uint stratum = permute(aij, s, q * STRATUM_KEY);
-    float sub = offset_sub(offset, v, M, i + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J);
+    uint sub = offset_sub(offset, v, M, i + 1u, aij, q * SUBSTRATUM_KEY);
+    return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J, offset);
 }
 
 float bush(uint i, uint j, uint s, uint t, uint p, uint offset, float J, __global const ushort *gf, uint tabled)
@@ -99,8 +100,8 @@ float bush(uint i, uint j, uint s, uint t, uint p, uint offset, float J, __globa
     uint aij, u;
     bush_cell(i, j % (s + 1u), s, t, M, gf, tabled, &aij, &u);
     uint stratum = permute(aij, s, q * STRATUM_KEY);
-    float sub = offset_sub(offset, u, M, i + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J);
+    uint sub = offset_sub(offset, u, M, i + 1u, aij, q * SUBSTRATUM_KEY);
+    return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J, offset);
 }
 
 /* Addelman-Kempthorne: A_ij of column j < 2q+1 and the sub-stratum index u
@@ -138,8 +139,8 @@ void bose_bush_cell(uint i, uint j, uint s, __global const ushort *gf, uint tabl
 float index2_value(uint i, uint j, uint s, uint aij, uint u, uint q, uint offset, float J)
 {
     uint stratum = permute(aij, s, q * STRATUM_KEY);
-    float sub = offset_sub(offset, u, 2u * s, i + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, 2u * s, s, J);
+    uint sub = offset_sub(offset, u, 2u * s, i + 1u, aij, q * SUBSTRATUM_KEY);
+    return oa_value(i, stratum, sub, q * JITTER_KEY, 2u * s, s, J, offset);
 }
 
 float addelman_kempthorne(uint i, uint j, uint s, uint p, uint offset, float J,

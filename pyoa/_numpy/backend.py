@@ -64,7 +64,7 @@ class NumpyBackend:
         stratum = strata[:, d, aij]  # (pixels, samples, dims)
         if req.offset == "cmj":
             subs = permute(np.arange(M, dtype=U32), M, (q * U32(SUBSTRATUM_KEY))[..., None])
-            sub = subs[:, d, u].astype(F32)
+            sub = subs[:, d, u]
         else:
             sub = F32((M - 1) / 2)
         i = req.samples[rect.k0 : rect.k1][None, :, None]

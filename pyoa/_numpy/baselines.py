@@ -112,8 +112,8 @@ def cmj2d(i, j, m: int, n: int, p, jitter: float = 1.0) -> np.ndarray:
     sy = permute(k // U32(m), n, q * U32(SUBY_KEY))
     even = (j & U32(1)) == 0
     jit = jitter_value(randfloat(k, q * np.where(even, U32(JITX_KEY), U32(JITY_KEY))), J)
-    x = sample_value(k % U32(m), sy.astype(F32), jit, n, m)
-    y = sample_value(k // U32(m), sx.astype(F32), jit, m, n)
+    x = sample_value(k % U32(m), sy, jit, n, m)
+    y = sample_value(k // U32(m), sx, jit, m, n)
     return np.where(even, x, y)
 
 

@@ -2,7 +2,7 @@
 and, piece by piece, ``kernels/oa.cl``).
 
 Each function takes broadcastable arrays of sample indices ``i``, dimensions
-``j`` (any ``j >= 0``; blocks per SPEC section 6) and array seeds ``p`` and
+``j`` (any ``j >= 0``; blocks per docs/spec.md section 6) and array seeds ``p`` and
 returns float32 values; see the reference for the mathematics. The pieces
 (column key, cell, offset, value) are public to this package because the
 NumPy backend's table path (:mod:`.backend`) reuses them.
@@ -100,7 +100,7 @@ def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
     if offset == "centered":
         return F32((M - 1) / 2)
     seed = {"j": cell_key * P2, "mj": (aij + U32(1)) * P2, "cmj": P2}[offset]
-    return permute(u, M, seed).astype(F32)
+    return permute(u, M, seed)
 
 
 def oa_value(i, stratum, sub, P3, M: int, s: int, jitter: float) -> np.ndarray:

@@ -13,7 +13,7 @@ from .device import DeviceInfo
 
 #: Work-items per group when an axis is split (see OpenCLBackend._launch_2d).
 #: PoCL vectorizes across work-items only when it knows the group size, and
-#: leaving it to PoCL halved throughput (POCL-NOTES.md).
+#: leaving it to PoCL halved throughput (docs/performance.md, lessons for PoCL).
 GROUP_SIZE = 64
 #: Upper bound on one launch's output buffer (OpenCL buffers may not exceed
 #: 2 GiB, and CL_DEVICE_MAX_MEM_ALLOC_SIZE may be smaller still).
@@ -201,12 +201,12 @@ class OpenCLBackend:
             self._launch_2d(name, Es, n_pd, tab, keys, np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M))
         aij, u = cells(req, rect.k0, rect.k1)
         self._launch_2d(
-            "generate_cells", n_k, n_pd,
+            "generate_cells_centered" if req.offset == "centered" else "generate_cells", n_k, n_pd,
             buf, np.uint32(at), tab,
             cl.Buffer(self.context, ro, hostbuf=aij), cl.Buffer(self.context, ro, hostbuf=u),
             cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1])),
             np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M),
-            np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+            np.float32(req.jitter),
         )
 
 

@@ -23,7 +23,7 @@ __kernel void t_seeds(__global const uint *a, __global const uint *b, __global u
                       __global uint *pix, __global uint *blk)
 { size_t g = get_global_id(0); mix[g] = mix32(a[g]); pix[g] = pixel_seed(a[g], b[g]); blk[g] = block_seed(a[g], b[g]); }
 
-__kernel void t_sample_value(__global const uint *stratum, __global const float *sub, __global const float *jit,
+__kernel void t_sample_value(__global const uint *stratum, __global const uint *sub, __global const float *jit,
                              const uint M, const uint s, __global float *out)
 { size_t g = get_global_id(0); out[g] = sample_value(stratum[g], sub[g], jit[g], M, s); }
 
@@ -114,13 +114,13 @@ def test_seed_hashes_match_c_oracle(harness, spec_c):
 
 def test_sample_value_clamps_below_one(harness):
     """stratum s-1, sub M-1, jitter just below 1: the exact result rounds to 1.0 and
-    must become 0x3f7fffff (SPEC section 7)."""
+    must become 0x3f7fffff (docs/spec.md section 7)."""
     from pyoa.reference.floats import sample_value
 
     jit = np.float32(1) - np.float32(2**-24)  # 0x3f7fffff
     cases = [(3, 3), (7, 49), (13, 13), (2, 2**23), (4093, 4093)]
     for s, M in cases:
-        got = harness("t_sample_value", [np.float32], np.array([s - 1], U32), np.array([M - 1], np.float32),
+        got = harness("t_sample_value", [np.float32], np.array([s - 1], U32), np.array([M - 1], U32),
                       np.array([jit], np.float32), U32(M), U32(s))
         want = np.float32(sample_value(s - 1, M - 1, float(jit), M, s))
         assert got.view(U32)[0] == want.view(U32) == 0x3F7FFFFF, (s, M)

@@ -1,4 +1,4 @@
-/* An independent C implementation of SPEC.md sections 2, 3, 5 (Bose, CMJND),
+/* An independent C implementation of docs/spec.md sections 2, 3, 5 (Bose, CMJND),
  * 6 and 7, written from the specification text (and, for mix32 / hash_pair /
  * pixel_seed / block_seed, from the documented choices in the docstrings of
  * pyoa/reference/hashes.py: Wellons' lowbias32 and hash_pair(a, b, key) =
@@ -18,7 +18,7 @@
  *
  * Float32 arithmetic: on x86-64 (SSE) and aarch64 a C float expression is
  * evaluated in float32, one correctly rounded operation at a time;
- * -ffp-contract=off forbids fused multiply-adds (SPEC section 7). The
+ * -ffp-contract=off forbids fused multiply-adds (docs/spec.md section 7). The
  * volatile temporaries force each intermediate to be stored as a float.
  */
 #include <stdint.h>
@@ -30,7 +30,7 @@ typedef uint32_t u32;
 static float from_bits(u32 u) { float f; memcpy(&f, &u, 4); return f; }
 static u32 to_bits(float f) { u32 u; memcpy(&u, &f, 4); return u; }
 
-/* SPEC section 2 */
+/* docs/spec.md section 2 */
 static u32 permute(u32 i, u32 l, u32 p)
 {
     u32 w;
@@ -88,7 +88,33 @@ static u32 hash_pair(u32 a, u32 b, u32 key)
 static u32 pixel_seed(u32 seed, u32 pixel) { return hash_pair(seed, pixel, 0x5bd1e995u); }
 static u32 block_seed(u32 p, u32 block) { return block == 0 ? p : hash_pair(p, block, 0x1b873593u); }
 
-/* SPEC sections 1, 3 and 7: x = (stratum + (sub + jitter) / M) / s, clamped below 1 */
+/* x * n compared with c exactly, in integers (docs/spec.md section 7): x = m 2^-e with
+ * m its 24-bit significand, so x * n < c iff m n < c 2^e; m n < 2^49, and for
+ * e >= 49 (x < 2^-25) the right side wins whenever c > 0, as it does when
+ * c 2^e would overflow 64 bits. Returns -1, 0, 1. */
+static int cmp_xn_c(float x, u32 n, u32 c)
+{
+    u32 b = to_bits(x), ef = b >> 23;
+    unsigned long long m = ef ? ((b & 0x7fffffu) | 0x800000u) : (b & 0x7fffffu);
+    int e = (ef ? 150 - (int)ef : 149);
+    unsigned long long lhs = m * n;
+    if (e >= 49) return c ? -1 : (lhs ? 1 : 0);
+    if (e > 0 && ((unsigned long long)c >> (64 - e)) != 0) return -1;  /* c 2^e >= 2^64 > m n */
+    unsigned long long rhs = (unsigned long long)c << e;
+    return lhs < rhs ? -1 : lhs > rhs ? 1 : 0;
+}
+
+/* the cell clamp of docs/spec.md section 7, by definition: step one float32 at a time */
+static float cell_clamp(float x, u32 c, u32 n)
+{
+    while (cmp_xn_c(x, n, c + 1) >= 0) x = from_bits(to_bits(x) - 1);
+    while (cmp_xn_c(x, n, c) < 0) x = from_bits(to_bits(x) + 1);
+    return x;
+}
+
+/* docs/spec.md sections 1, 3 and 7: x = (stratum + (sub + jitter) / M) / s, clamped into
+ * its cell (the fine cell stratum M + sub, or the coarse stratum when sub is the
+ * half-integer of 'centered' with even M) */
 static float value(u32 stratum, float sub, u32 i, u32 P3, float J, u32 M, u32 s)
 {
     volatile float r, jit, a, b, c, x;
@@ -100,13 +126,13 @@ static float value(u32 stratum, float sub, u32 i, u32 P3, float J, u32 M, u32 s)
     b = a / (float)M;
     c = (float)stratum + b;
     x = c / (float)s;
-    if (x >= 1.0f) x = from_bits(0x3f7fffffu);
-    return x;
+    if ((float)(u32)sub == sub) return cell_clamp(x, stratum * M + (u32)sub, M * s);
+    return cell_clamp(x, stratum, s);
 }
 
 enum { CENTERED = 0, JITTERED = 1, MJ = 2, CMJ = 3 };
 
-/* SPEC section 5, Bose; section 6 blocks of s+1 columns */
+/* docs/spec.md section 5, Bose; section 6 blocks of s+1 columns */
 static float bose(u32 i, u32 j, u32 s, u32 p, int off, float J)
 {
     u32 block = j / (s + 1), a0, a1, aij, aik, k, P1, P2, P3, stratum;
@@ -134,7 +160,7 @@ static float bose(u32 i, u32 j, u32 s, u32 p, int off, float J)
     return value(stratum, sub, i, P3, J, s, s);
 }
 
-/* SPEC section 5, CMJND; section 6 blocks of t columns */
+/* docs/spec.md section 5, CMJND; section 6 blocks of t columns */
 static float cmjnd(u32 i, u32 j, u32 s, u32 t, u32 p, int off, float J)
 {
     u32 block = j / t, M = 1, sj = 1, d, aij, v, P1, P2, P3, stratum, c, pw;
