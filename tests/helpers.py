@@ -114,7 +114,7 @@ def reference_block(smp, pixels, samples, dims) -> np.ndarray:
 # --------------------------------------------------------------------------- canonical arrays
 
 def bose_symbol(i: int, j: int, s: int) -> int:
-    """A_ij of the plain Bose array (SPEC section 5)."""
+    """A_ij of the plain Bose array (docs/spec.md section 5)."""
     a0, a1 = divmod(i, s)
     if j == 0:
         return a0
@@ -124,7 +124,7 @@ def bose_symbol(i: int, j: int, s: int) -> int:
 
 
 def bose_partner(j: int, s: int) -> int:
-    """The partner column k of j (SPEC section 5), as a column index whose symbol
+    """The partner column k of j (docs/spec.md section 5), as a column index whose symbol
     formula uses the multiplier (k-1) mod s."""
     if j == 0:
         return 1
@@ -314,7 +314,7 @@ def bush_symbol(i: int, j: int, t: int, F: PolyField) -> int:
     return c[t - 1] if j == s else F.poly_at(c, j)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def field_tables(q: int) -> tuple[np.ndarray, np.ndarray]:
     """(add, mul) q x q tables of :func:`field_for` (independent of pyoa.gf), cached."""
     F = field_for(q)
@@ -323,7 +323,7 @@ def field_tables(q: int) -> tuple[np.ndarray, np.ndarray]:
     return add, mul
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def plain_bush_array(s: int, t: int) -> np.ndarray:
     """The whole plain Bush array (N, s+1) of :func:`bush_symbol`, vectorized over
     :func:`field_tables`, term by term; read-only and cached."""
@@ -342,7 +342,7 @@ def plain_bush_array(s: int, t: int) -> np.ndarray:
     return A
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def plain_gf_bose_array(q: int) -> tuple[np.ndarray, np.ndarray]:
     """``(A, A_partner)``, each (q^2, q+1), of :func:`gf_bose_symbol`; read-only, cached."""
     F = field_for(q)
@@ -380,7 +380,7 @@ def index2_levels(name: str) -> list[int]:
     return out
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def field_inverses(q: int) -> tuple[int, ...]:
     """``inv[a]`` (``inv[0] = 0``) in :func:`field_for` GF(q), from the powers of a
     primitive element (``inv(g^e) = g^(q-1-e)``): no Fermat exponentiation, no tables
@@ -401,7 +401,7 @@ def field_inverses(q: int) -> tuple[int, ...]:
     return tuple(inv)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def ak_constants_independent(q: int, kappa: int | None = None) -> tuple[int, tuple, tuple, tuple]:
     """``(kappa, b, k, c)`` of Addelman-Kempthorne (1961) / Hedayat-Sloane-Stufken 3.4
     as pyoa documents them (kappa the smallest non-square by code; b[m] =
@@ -453,7 +453,7 @@ def ak_symbol(i: int, j: int, q: int) -> tuple[int, int]:
     return a, u
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def plain_ak_array(q: int, kappa: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(A, U)``, each (2q^2, 2q+1): :func:`ak_symbol` over the whole array,
     vectorized over :func:`field_tables` (independent of pyoa.gf); read-only, cached.
@@ -492,7 +492,7 @@ def bose_bush_symbol(i: int, j: int, s: int) -> tuple[int, int]:
     return x % s, (x // s) * s + k
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def plain_bose_bush_array(s: int) -> tuple[np.ndarray, np.ndarray]:
     """``(A, U)``, each (2s^2, 2s+1), of :func:`bose_bush_symbol`, vectorized over
     :func:`field_tables` of GF(2s); read-only, cached."""
@@ -520,8 +520,9 @@ def index2_symbol(name: str, i: int, j: int, s: int) -> tuple[int, int]:
 # --------------------------------------------------------------------------- OA / LH checks
 
 def strata_exact(x: np.ndarray, s: int) -> np.ndarray:
-    """Coarse strata of values generated with jitter 0 (points at fine-cell centres,
-    far from every boundary, so floor is exact)."""
+    """``floor(x*s)``: the stratum of each value among ``s`` (exact in float64 for
+    float32 values and ``s <= 2**24``; values are clamped into their cells, so
+    this is the stratum the construction chose, at any jitter amount)."""
     return np.floor(np.asarray(x, np.float64) * s).astype(np.int64)
 
 
@@ -549,22 +550,12 @@ def assert_oa(strata: np.ndarray, s: int, t: int, cols=None, what: str = "") -> 
 
 
 def assert_latin_exact(x: np.ndarray, N: int, what: str = "") -> None:
-    """floor(x*N) is a permutation of 0..N-1 in every column (jitter 0 values)."""
+    """floor(x*N) is a permutation of 0..N-1 in every column (exact: see
+    :func:`strata_exact`; any jitter amount)."""
     cells = np.sort(np.floor(np.asarray(x, np.float64) * N).astype(np.int64), axis=-2)
     want = np.arange(N).reshape((N, 1))
     ok = np.all(cells == want, axis=-2)
     assert np.all(ok), f"{what}: {np.size(ok) - np.count_nonzero(ok)} columns are not Latin hypercubes at {N} cells"
-
-
-def assert_latin_closed(x: np.ndarray, N: int, what: str = "") -> None:
-    """1D Latin hypercube up to float32 rounding: the k-th smallest value of every
-    column lies in the closed cell [k/N, (k+1)/N] (a jittered value may round
-    onto the upper boundary of its cell), within a few float32 ulps."""
-    xs = np.sort(np.asarray(x, np.float64), axis=-2) * N
-    k = np.arange(N).reshape((N, 1))
-    tol = 4 * N * 2.0**-24
-    dev = np.maximum(k - xs, xs - (k + 1))
-    assert dev.max() <= tol, f"{what}: a sorted value is {dev.max():.3g} cells outside its Latin-hypercube cell"
 
 
 def in_unit_interval(x) -> bool:
@@ -635,7 +626,7 @@ def _unxorshift(y: int, k: int) -> int:
 
 
 def randfloat_preimage(h: int, p: int) -> int:
-    """The i for which randfloat's integer hash (SPEC section 2, before the float
+    """The i for which randfloat's integer hash (docs/spec.md section 2, before the float
     conversion) of (i, p) equals h; p != 0. Every step of the hash is a bijection."""
     M = 2**32
     x = (h * pow(1 | (p >> 18), -1, M)) % M

@@ -7,7 +7,7 @@ values the samplers produce (bulk values from the NumPy functions or from
 stratification over many seeds, equality with SciPy's unscrambled Sobol and
 with an independently computed radical inverse, Owen (nested) rather than
 positional scrambling, independence of the padded pairs, unbiasedness of
-estimates (SPEC 8.6), the catalogue, the API and the command line.
+estimates (docs/spec.md 8.6), the catalogue, the API and the command line.
 Bit-for-bit agreement of the backends is tests/test_baselines_conformance.py.
 
 Exact stratification of float32 values
@@ -16,24 +16,26 @@ Exact stratification of float32 values
 for power-of-two cell counts ``floor(x * 2**u)`` is exact.
 
 ``jittered2d`` and ``cmj2d`` values are ``(stratum + (sub + jitter) / M) / s``
-in float32 (SPEC section 7). Round to nearest is monotone, so a value of cell
-``r`` lies in the *closed* float32 image ``[B_r, B_r+1]`` of that cell, where
-``B_r`` is the same float32 formula at ``jitter = 0`` (an exact float32
-computation here, with NumPy's correctly rounded float32 operations). The value
-can land exactly on ``B_r+1`` (``stratum + jitter`` rounds up to the next
-integer once ``jitter > 1 - ulp/2``: at N = 4096 that happens in ~1 in 8000
-points) and ``B_r`` itself can be below ``r / N``; so ``floor(x * N)`` is *not*
-a valid cell index. The check here is tolerance-free: a value strictly inside
-``(B_r, B_r+1)`` belongs to cell r alone, a value equal to a boundary to either
-neighbour, and the set is stratified iff the points can be matched one to one
-with the cells they may belong to (:func:`assert_one_per_cell`).
+in float32 (docs/spec.md section 7), clamped into their cell: ``c / N <= x < (c + 1) /
+N`` as real numbers for the cell ``c = stratum * M + sub`` of ``N = s * M``
+(:func:`pyoa.reference.floats.sample_value`). For a float32 ``x`` and an
+integer ``n <= 2**24`` the float64 product ``x * n`` is exact (24 + 25
+significant bits fit in 53), so ``floor(x * n)`` *is* the index of the cell
+``[c / n, (c + 1) / n)`` holding ``x`` (:func:`cells`): the checks compare
+integers, with no tolerance. Without the clamp they would fail: the rounded
+formula puts values on, or one ulp across, a cell edge
+(:func:`test_clamp_keeps_values_in_their_cells` shows it happen).
 
 ``halton`` truncates the exact scrambled fraction ``t`` to 24 bits, ``x =
-floor(2**24 t) / 2**24``. A point of interval ``[a, a+1) / b**k`` has
-``2**24 x`` in ``[T_a, T_a+1]`` with the integers ``T_a = floor(2**24 a /
+floor(2**24 t) / 2**24``, by design. A point of interval ``[a, a+1) / b**k``
+has ``2**24 x`` in ``[T_a, T_a+1]`` with the integers ``T_a = floor(2**24 a /
 b**k)``: it may sit exactly on the truncated upper boundary (this happens, for
-b**k ~ 250 about once per 10**5 points). The same matching check is exact
-with those integer boundaries.
+b**k ~ 250 about once per 10**5 points), so ``floor(x * b**k)`` is not its
+interval. The check is still tolerance-free: a value strictly inside ``(T_a,
+T_a+1) / 2**24`` belongs to interval a alone, a value equal to a boundary to
+either neighbour, and the set is stratified iff the points can be matched one
+to one with the intervals they may belong to
+(:func:`assert_one_per_closed_cell`).
 """
 
 from __future__ import annotations
@@ -50,10 +52,13 @@ from hypothesis import strategies as st
 import pyoa
 from pyoa import sequences
 from pyoa._numpy import baselines as nb
+from pyoa._numpy.floats import jitter_value
+from pyoa._numpy.hashes import permute, pixel_seed, randfloat
 from pyoa.reference import baselines as rb
 from tests.helpers import U32_MAX, assert_same_bits, run_cli
 
 F32 = np.float32
+U32 = np.uint32
 UNIT24 = 2.0**-24
 NAMES = ["random", "jittered2d", "cmj2d", "sobol02", "halton", "sobol"]
 
@@ -87,24 +92,39 @@ def most_square(N: int) -> tuple[int, int]:
     return m, N // m
 
 
-def float_bounds(ncells: int) -> np.ndarray:
-    """``B_r = f32(r) / f32(ncells)`` for r = 0..ncells (float32 division): the
-    closed float32 images of the cells of ``(stratum + jitter) / ncells``."""
-    return np.arange(ncells + 1, dtype=F32) / F32(ncells)
+def cells(x: np.ndarray, n: int) -> np.ndarray:
+    """``floor(x * n)`` for float32 ``x`` and an integer ``1 <= n <= 2**24``: the
+    index c of the cell ``[c / n, (c + 1) / n)`` that holds ``x``, exactly (the
+    float64 product of a 24-bit significand and a 25-bit integer is not rounded)."""
+    assert 1 <= n <= 2**24
+    return np.floor(np.asarray(x, dtype=F32).astype(np.float64) * n).astype(np.int64)
 
 
-def fine_bounds(coarse: int, fine: int) -> np.ndarray:
-    """Boundaries of the N = coarse * fine strata of ``sample_value(r // fine, r %
-    fine, jitter, fine, coarse)`` = ``(r // fine + (r % fine + jitter) / fine) /
-    coarse``, evaluated in float32 at jitter 0, for r = 0..N."""
-    r = np.arange(coarse * fine + 1)
-    hi = (r // fine).astype(F32)
-    lo = (r % fine).astype(F32)
-    return (hi + lo / F32(fine)) / F32(coarse)
+def assert_one_per_cell(cx: np.ndarray, nx: int, cy: np.ndarray | None = None, ny: int = 1,
+                        what: str = "") -> None:
+    """Every point set holds exactly one point in every cell of an ``nx x ny`` grid.
+
+    ``cx`` and ``cy`` are integer cell indices (:func:`cells`) of shape ``(sets,
+    N)``, ``cy = None`` a 1D stratification into ``nx`` cells. Since the indices
+    are exact, a set is stratified iff its cell codes are a permutation of 0..N-1.
+    """
+    cx = np.atleast_2d(cx)
+    cy = np.zeros_like(cx) if cy is None else np.atleast_2d(cy)
+    S, N = cx.shape
+    assert N == nx * ny, f"{what}: {N} points for a {nx} x {ny} grid"
+    assert cx.min() >= 0 and cx.max() < nx and cy.min() >= 0 and cy.max() < ny, f"{what}: a value outside [0, 1)"
+    code = np.sort(cx * ny + cy, axis=1)
+    bad = np.flatnonzero(np.any(code != np.arange(N), axis=1))
+    if bad.size:  # N codes in [0, N) that are not a permutation: one repeats
+        s = int(bad[0])
+        c = int(code[s, 1:][code[s, 1:] == code[s, :-1]][0])
+        raise AssertionError(f"{what}: {bad.size} of {S} sets are not one point per cell; first: set {s}, "
+                             f"cell (x {c // ny} of {nx}, y {c % ny} of {ny}) holds several points")
 
 
 def truncated_bounds(ncells: int) -> np.ndarray:
-    """``floor(2**24 a / ncells) / 2**24`` for a = 0..ncells, as float32 (exact)."""
+    """``floor(2**24 a / ncells) / 2**24`` for a = 0..ncells, as float32 (exact):
+    the closed float32 images of halton's intervals ``[a, a+1) / ncells``."""
     a = np.arange(ncells + 1, dtype=np.int64)
     return ((a << 24) // ncells).astype(np.float64).astype(F32) * F32(UNIT24)
 
@@ -139,8 +159,9 @@ def _perfect_matching(cands: list[list[int]], free: set[int]) -> bool:
     return all(place(k, set()) for k in range(len(cands)))
 
 
-def assert_one_per_cell(cols, rows=None, what: str = "") -> None:
-    """Every point set holds exactly one point in every cell of a grid.
+def assert_one_per_closed_cell(cols, rows=None, what: str = "") -> None:
+    """Every point set holds exactly one point in every closed cell of a grid
+    (halton's truncated intervals, see the module docstring).
 
     ``cols`` and ``rows`` are ``(hi, amb, ncells)`` of :func:`candidates` for
     the x and y axes, ``hi`` and ``amb`` of shape ``(sets, N)``; ``rows=None``
@@ -213,15 +234,14 @@ def grid(f, N: int, dims, p, *shape, jitter=None) -> np.ndarray:
 # =============================================================================== jittered2d
 
 def check_jittered2d(x: np.ndarray, m: int, dims: int, what: str) -> None:
-    """x: (sets, m*m, dims). Pairs (0,1), (2,3)...: m x m grids; a lone last dim: m*m strata."""
+    """x: (sets, m*m, dims). Pairs (0,1), (2,3)...: one point in every cell of the
+    m x m grid; a lone last dimension: one point in every one of its m*m strata."""
     N = m * m
-    B = float_bounds(m)
     for a in range(0, dims - 1, 2):
-        assert_one_per_cell(candidates(x[:, :, a], B) + (m,), candidates(x[:, :, a + 1], B) + (m,),
+        assert_one_per_cell(cells(x[:, :, a], m), m, cells(x[:, :, a + 1], m), m,
                             f"{what}: pair ({a},{a + 1}) as an {m}x{m} grid")
     if dims % 2:
-        assert_one_per_cell(candidates(x[:, :, dims - 1], float_bounds(N)) + (N,),
-                            what=f"{what}: lone last dimension {dims - 1} in {N} strata")
+        assert_one_per_cell(cells(x[:, :, dims - 1], N), N, what=f"{what}: lone last dimension {dims - 1} in {N} strata")
 
 
 @pytest.mark.parametrize("m", [1, 2, 3, 5, 8, 13, 16, 45, 64])
@@ -232,15 +252,15 @@ def test_jittered2d_grids_many_seeds(m, jitter):
     check_jittered2d(x, m, dims, f"jittered2d m={m} jitter={jitter}")
 
 
-def test_jittered2d_large_grid_rounding_onto_boundaries():
-    """m = 64 and the lone dimension of N = 4096 strata: f32(k + jitter) rounds up
-    to k+1 for jitter > 1 - 2**-13, so here values do sit on cell boundaries
-    (the case the closed-cell matching exists for); still one point per cell."""
-    m, dims = 64, 3
-    x = grid(nb.jittered2d, m * m, range(dims), np.arange(1, 49, dtype=np.uint32) * 0x9E3779B1, m, dims, jitter=1.0)
-    _, amb = candidates(x[:, :, 2], float_bounds(m * m))
-    assert amb.any(), "expected some values exactly on a stratum boundary at N = 4096 (see the module docstring)"
-    check_jittered2d(x, m, dims, "jittered2d m=64")
+@pytest.mark.parametrize("m, n_seeds", [(181, 8), (256, 4), (1024, 1)])
+def test_jittered2d_large_grids(m, n_seeds):
+    """Fewer seeds, larger grids: the lone dimension's strata get as narrow as
+    2**-20 (m = 1024), only 16 float32 steps below 1, and N = 181**2 is no power
+    of two (its cell edges are not float32 values, so the formula can round
+    below a cell as well as onto the next one)."""
+    dims = 3
+    x = grid(nb.jittered2d, m * m, range(dims), P_SEEDS[:n_seeds], m, dims, jitter=1.0)
+    check_jittered2d(x, m, dims, f"jittered2d m={m}")
 
 
 @given(p=seeds, m=st.integers(1, 24), dims=st.integers(1, 7),
@@ -253,12 +273,12 @@ def test_jittered2d_hypothesis(p, m, dims, jitter):
 def test_jittered2d_jitter0_cell_centres():
     """jitter = 0: every value is the float32 centre f32(c + 0.5) / m of its cell
     (the lone dimension: of its N strata), for any seed."""
-    for m, dims in [(1, 3), (3, 5), (7, 3), (16, 7), (45, 1)]:
+    for m, dims in [(1, 3), (3, 5), (7, 3), (16, 7), (45, 1), (64, 3)]:
         N = m * m
         x = grid(nb.jittered2d, N, range(dims), P_SEEDS, m, dims, jitter=0.0)
         for j in range(dims):
             s = N if (j == dims - 1 and j % 2 == 0) else m
-            c = np.floor(x[:, :, j].astype(np.float64) * s)
+            c = cells(x[:, :, j], s)
             assert_same_bits(x[:, :, j], (c.astype(F32) + F32(0.5)) / F32(s), f"jittered2d m={m} dim {j} centres")
         check_jittered2d(x, m, dims, f"jittered2d m={m} jitter=0")
     # p = 0: cell centres in natural order (cell k = i: column i mod m, row i // m)
@@ -270,19 +290,23 @@ def test_jittered2d_jitter0_cell_centres():
     assert_same_bits(x[:, 2], (i.astype(F32) + F32(0.5)) / F32(m * m), "p=0 lone dimension centres")
 
 
-def test_jittered2d_jitter_moves_points_within_their_cell():
+@pytest.mark.parametrize("m", [11, 64])
+@pytest.mark.parametrize("jitter", [1.0, 0.37])
+def test_jittered2d_jitter_moves_points_within_their_cell(m, jitter):
     """Jitter only moves a point inside its cell: the values of the same (p, i, j)
-    at jitter 0 (centre) and 1 are in the same closed cell."""
-    m, dims = 11, 5
+    at jitter 0 (the centre) and at jitter J lie in the same cell, exactly (the
+    shuffle does not depend on the jitter amount)."""
+    dims = 5
     c0 = grid(nb.jittered2d, m * m, range(dims), P_SEEDS, m, dims, jitter=0.0)
-    c1 = grid(nb.jittered2d, m * m, range(dims), P_SEEDS, m, dims, jitter=1.0)
+    c1 = grid(nb.jittered2d, m * m, range(dims), P_SEEDS, m, dims, jitter=jitter)
     for j in range(dims):
-        B = float_bounds(m * m if j == dims - 1 else m)
-        cell = np.searchsorted(B, c0[:, :, j], side="right") - 1  # centres: unambiguous
-        assert np.all((B[cell] <= c1[:, :, j]) & (c1[:, :, j] <= B[cell + 1])), f"dim {j}: jitter left the cell"
+        n = m * m if j == dims - 1 else m
+        moved = np.flatnonzero(cells(c1[:, :, j], n) != cells(c0[:, :, j], n))
+        assert moved.size == 0, f"dim {j}: jitter {jitter} moved {moved.size} points out of their cell"
+        assert np.any(c1[:, :, j] != c0[:, :, j]), f"dim {j}: jitter {jitter} moved no point"
 
 
-@pytest.mark.parametrize("m, dims", [(8, 7), (12, 4)])
+@pytest.mark.parametrize("m, dims", [(8, 7), (12, 4), (64, 3)])
 def test_jittered2d_sampler_pixels(backend, m, dims):
     for seed in (0, 1, 99):
         smp = pyoa.sampler("jittered2d", spp=m * m, dims=dims, seed=seed, backend=backend)
@@ -293,22 +317,18 @@ def test_jittered2d_sampler_pixels(backend, m, dims):
 
 def check_cmj2d(x: np.ndarray, N: int, dims: int, what: str) -> None:
     """x: (sets, N, dims). Pairs: m x n grids (x in m columns, y in n rows, m, n
-    from :func:`most_square`), every dimension a Latin hypercube of N strata."""
+    from :func:`most_square`), every dimension a Latin hypercube of N strata
+    (a lone last dimension is the x of its pair: the Latin check is all there is
+    for it)."""
     m, n = most_square(N)
-    for a in range(0, dims, 2):
-        # x = (column + (sub-column + jitter) / n) / m: fine stratum column*n + sub of N
-        # (a lone last dimension is the x of its pair: this check is all there is for it)
-        assert_one_per_cell(candidates(x[:, :, a], fine_bounds(m, n)) + (N,), what=f"{what}: dim {a} Latin in {N}")
-        if a + 1 < dims:
-            # y = (row + (sub-row + jitter) / m) / n: fine stratum row*m + sub of N
-            assert_one_per_cell(candidates(x[:, :, a + 1], fine_bounds(n, m)) + (N,),
-                                what=f"{what}: dim {a + 1} Latin in {N}")
-            assert_one_per_cell(candidates(x[:, :, a], float_bounds(m)) + (m,),
-                                candidates(x[:, :, a + 1], float_bounds(n)) + (n,),
-                                f"{what}: pair ({a},{a + 1}) as an {m}x{n} grid")
+    for a in range(dims):
+        assert_one_per_cell(cells(x[:, :, a], N), N, what=f"{what}: dim {a} Latin in {N}")
+    for a in range(0, dims - 1, 2):
+        assert_one_per_cell(cells(x[:, :, a], m), m, cells(x[:, :, a + 1], n), n,
+                            f"{what}: pair ({a},{a + 1}) as an {m}x{n} grid")
 
 
-CMJ_COUNTS = [1, 2, 3, 7, 12, 36, 120, 127, 128, 250, 1000, 4093]
+CMJ_COUNTS = [1, 2, 3, 7, 12, 36, 120, 127, 128, 250, 1000, 4093, 4096]
 
 
 @pytest.mark.parametrize("N", CMJ_COUNTS)
@@ -319,6 +339,15 @@ def test_cmj2d_grids_and_latin_many_seeds(N):
     check_cmj2d(x, N, dims, f"cmj2d N={N} ({m}x{n})")
 
 
+@pytest.mark.parametrize("N", [2**16, 2**20, 1000 * 1009])
+def test_cmj2d_large_grids(N):
+    """One seed, large grids: fine strata of width 2**-20 (N = 2**20) and of a
+    width that is no power of two (1000 x 1009)."""
+    m, n = most_square(N)
+    x = grid(nb.cmj2d, N, range(3), P_SEEDS[1:2], m, n, jitter=1.0)
+    check_cmj2d(x, N, 3, f"cmj2d N={N} ({m}x{n})")
+
+
 @given(p=seeds, N=st.integers(1, 300), dims=st.integers(1, 5), jitter=st.floats(0, 1) | st.just(1.0))
 def test_cmj2d_hypothesis(p, N, dims, jitter):
     m, n = most_square(N)
@@ -327,23 +356,150 @@ def test_cmj2d_hypothesis(p, N, dims, jitter):
 
 
 def test_cmj2d_jitter0_centres_of_fine_strata():
-    for N in (6, 120, 128, 127):
+    """jitter = 0: every coordinate is the float32 centre of its fine stratum r
+    of N (x: column r // n, sub-column r % n; y: row r // m, sub-row r % m)."""
+    for N in (6, 120, 128, 127, 4096):
         m, n = most_square(N)
-        x = grid(nb.cmj2d, N, range(2), P_SEEDS, m, n, jitter=0.0).astype(np.float64)
+        x = grid(nb.cmj2d, N, range(2), P_SEEDS, m, n, jitter=0.0)
         for j, (c, f) in enumerate([(m, n), (n, m)]):
-            r = np.floor(x[:, :, j] * N).astype(np.int64)  # centres: far from boundaries
+            r = cells(x[:, :, j], N)
             want = ((r // f).astype(F32) + ((r % f).astype(F32) + F32(0.5)) / F32(f)) / F32(c)
-            assert_same_bits(x[:, :, j].astype(F32), want, f"cmj2d N={N} dim {j} centres")
-            assert np.all(np.sort(r, axis=1) == np.arange(N)), f"cmj2d N={N} dim {j} jitter 0 not Latin"
+            assert_same_bits(x[:, :, j], want, f"cmj2d N={N} dim {j} centres")
+        check_cmj2d(x, N, 2, f"cmj2d N={N} jitter=0")
 
 
-@pytest.mark.parametrize("N, dims", [(120, 5), (128, 4), (97, 3)])
+@pytest.mark.parametrize("N", [120, 4096])
+def test_cmj2d_jitter_moves_points_within_their_fine_stratum(N):
+    """As for jittered2d: jitter moves a point inside its fine stratum, never out."""
+    m, n = most_square(N)
+    c0 = grid(nb.cmj2d, N, range(4), P_SEEDS, m, n, jitter=0.0)
+    for jitter in (1.0, 0.37):
+        c1 = grid(nb.cmj2d, N, range(4), P_SEEDS, m, n, jitter=jitter)
+        for j in range(4):
+            moved = np.flatnonzero(cells(c1[:, :, j], N) != cells(c0[:, :, j], N))
+            assert moved.size == 0, f"dim {j}: jitter {jitter} moved {moved.size} points out of their fine stratum"
+            assert np.any(c1[:, :, j] != c0[:, :, j]), f"dim {j}: jitter {jitter} moved no point"
+
+
+@pytest.mark.parametrize("N, dims", [(120, 5), (128, 4), (97, 3), (4096, 3)])
 def test_cmj2d_sampler_pixels(backend, N, dims):
     for seed in (0, 5):
         smp = pyoa.sampler("cmj2d", spp=N, dims=dims, seed=seed, backend=backend)
         m, n = most_square(N)
         assert (smp.s, smp.params.M) == (m, n)
         check_cmj2d(smp.generate(pixels=PIXELS), N, dims, f"sampler N={N} seed={seed}")
+
+
+# =============================================================================== the cell clamp
+
+def unclamped(stratum, sub, jit, M: int, s: int) -> np.ndarray:
+    """docs/spec.md section 7's ``(stratum + (sub + jitter) / M) / s`` as four correctly
+    rounded float32 operations, *without* the cell clamp."""
+    return (np.asarray(stratum).astype(F32) + (np.asarray(sub).astype(F32) + jit) / F32(M)) / F32(s)
+
+
+def construction(name: str, size: tuple[int, int], i, j: int, p, jitter: float):
+    """``(stratum, sub, jit, M, s)`` of dimension ``j`` of ``jittered2d`` (``size
+    = (m, dims)``) or ``cmj2d`` (``size = (m, n)``), written out from the docstrings
+    of :mod:`pyoa.reference.baselines` with pyoa's hash primitives (checked against
+    the C oracle in tests/reference/test_hashes.py); the cell of the value is
+    ``stratum * M + sub`` of ``s * M``."""
+    i, p = np.asarray(i, dtype=U32), np.asarray(p, dtype=U32)
+    q = nb.derived_seed(p, U32(j >> 1), rb.PAD_KEY)
+    a, b = size
+    k = permute(i, a * a if name == "jittered2d" else a * b, q * U32(rb.SHUFFLE_KEY))
+    jit = jitter_value(randfloat(k, q * U32(rb.JITY_KEY if j % 2 else rb.JITX_KEY)), F32(jitter))
+    zero = np.zeros(k.shape, dtype=U32)
+    if name == "jittered2d":
+        m, dims = a, b
+        if j % 2 == 0 and j + 1 == dims:  # a lone last dimension: m*m strata
+            return k, zero, jit, 1, m * m
+        return (k // U32(m) if j % 2 else k % U32(m)), zero, jit, 1, m
+    m, n = a, b
+    if j % 2 == 0:  # x: column k mod m, sub-column permute(k // m, n, q SUBY_KEY)
+        return k % U32(m), permute(k // U32(m), n, q * U32(rb.SUBY_KEY)), jit, n, m
+    return k // U32(m), permute(k % U32(m), m, q * U32(rb.SUBX_KEY)), jit, m, n
+
+
+def check_clamped(name: str, size: tuple[int, int], x: np.ndarray, i, p, jitter: float,
+                  what: str) -> tuple[int, int]:
+    """The values ``x`` (``(..., dims)``, from sample indices ``i`` and seeds ``p``
+    that broadcast to ``x[..., 0]``) lie in their cells exactly, and the clamp is
+    the only change to the float32 formula: a formula value inside its cell is
+    kept bit for bit, one outside becomes the nearest float32 inside (the largest
+    below the cell's upper edge, or the smallest at or above its lower edge).
+    Returns the numbers of formula values above and below their cells."""
+    above = below = 0
+    for j in range(x.shape[-1]):
+        stratum, sub, jit, M, s = construction(name, size, i, j, p, jitter)
+        stratum, sub, jit = np.broadcast_arrays(stratum, sub, jit)
+        n, xj = s * M, x[..., j]
+        c = stratum.astype(np.int64) * M + sub
+        bad = np.argwhere(cells(xj, n) != c)
+        assert bad.size == 0, (f"{what}: dim {j}: {len(bad)} values outside their cell of {n}; first at "
+                               f"{tuple(bad[0])}: {xj[tuple(bad[0])]!r} not in cell {c[tuple(bad[0])]}")
+        u = unclamped(stratum, sub, jit, M, s)
+        cu = cells(u, n)
+        inside, up, down = cu == c, cu > c, cu < c
+        assert_same_bits(xj[inside], u[inside], f"{what}: dim {j}: a value inside its cell was changed")
+        assert np.all(cells(np.nextafter(xj[up], F32(np.inf)), n) == c[up] + 1), f"{what}: dim {j}: not the top"
+        assert np.all(cells(np.nextafter(xj[down], F32(-np.inf)), n) == c[down] - 1), f"{what}: dim {j}: not the bottom"
+        above += int(up.sum())
+        below += int(down.sum())
+    return above, below
+
+
+#: (name, size, sample count (None: all N samples, else that many random ones), seeds, lower)
+#: ``lower``: N is no power of two, so formula values also fall below their cells.
+CLAMP_CASES = [
+    pytest.param("jittered2d", (64, 3), None, 48, False, id="jittered2d-64x64"),
+    pytest.param("jittered2d", (181, 3), None, 8, True, id="jittered2d-181x181"),
+    pytest.param("jittered2d", (4096, 3), 1 << 16, 8, False, id="jittered2d-4096x4096"),
+    pytest.param("jittered2d", (4093, 1), 1 << 16, 8, True, id="jittered2d-4093x4093"),
+    pytest.param("cmj2d", (64, 64), None, 64, False, id="cmj2d-64x64"),
+    pytest.param("cmj2d", (1000, 1009), 1 << 16, 8, True, id="cmj2d-1000x1009"),
+    pytest.param("cmj2d", (4096, 4096), 1 << 16, 8, False, id="cmj2d-4096x4096"),
+    pytest.param("cmj2d", (4093, 4093), 1 << 16, 8, True, id="cmj2d-4093x4093"),
+]
+
+
+@pytest.mark.parametrize("name, size, n_samples, n_seeds, lower", CLAMP_CASES)
+def test_clamp_keeps_values_in_their_cells(name, size, n_samples, n_seeds, lower):
+    """Why the checks above can use ``floor(x * N)``: the float32 formula rounds
+    values onto or across their cells' edges (``stratum + jitter`` rounds up to
+    the next integer for jitter within half an ulp of 1; a division by an N that
+    is no power of two can round below ``c / N``), and the clamp puts exactly
+    those back. The counts of such values make sure the test cannot pass
+    without the clamp doing something: N = 4096 already has some per 10**5
+    values, N near 2**24 (cells of one float32 step near 1) a third of them.
+    Random sample indices stand for all N of the large sets."""
+    a, b = size
+    N = a * a if name == "jittered2d" else a * b
+    dims = b if name == "jittered2d" else 2
+    p = (np.arange(1, n_seeds + 1, dtype=U32) * U32(0x9E3779B1))[:, None]
+    if n_samples is None:
+        i = np.arange(N, dtype=U32)[None, :]
+    else:
+        i = np.random.default_rng(N).integers(0, N, (1, n_samples)).astype(U32)
+    fn = nb.jittered2d if name == "jittered2d" else nb.cmj2d
+    x = np.stack([fn(i, U32(j), a, b, p, 1.0) for j in range(dims)], axis=-1)
+    above, below = check_clamped(name, size, x, i, p, 1.0, f"{name} {a}x{b}")
+    assert above + below > 0, f"{name} {a}x{b}: no formula value outside its cell: the test shows nothing"
+    assert below > 0 or not lower, f"{name} {a}x{b}: no formula value below its cell: the lower clamp is untested"
+
+
+@pytest.mark.parametrize("name, spp, dims", [("jittered2d", 4096, 3), ("cmj2d", 4096, 2)])
+def test_clamp_keeps_sampler_values_in_their_cells(backend, name, spp, dims):
+    """The same on ``generate`` of each backend (the kernels clamp too)."""
+    pixels = np.arange(64, dtype=U32)
+    smp = pyoa.sampler(name, spp=spp, dims=dims, seed=2024, backend=backend)
+    m, n = most_square(spp)
+    size = (m, dims) if name == "jittered2d" else (m, n)
+    p = pixel_seed(U32(2024), pixels)[:, None]
+    i = np.arange(spp, dtype=U32)[None, :]
+    above, below = check_clamped(name, size, smp.generate(pixels=pixels.tolist()), i, p, 1.0,
+                                 f"{name} sampler [{backend}]")
+    assert above + below > 0, f"{name}: no formula value outside its cell: the test shows nothing"
 
 
 # =============================================================================== sobol02
@@ -570,8 +726,8 @@ def check_halton(x: np.ndarray, dims, what: str) -> None:
         assert b <= n, f"{what}: dim {j} (base {b}) needs at least {b} samples, got {n}"
         k = 1
         while b**k <= n:
-            assert_one_per_cell(candidates(x[:, : b**k, c], truncated_bounds(b**k)) + (b**k,),
-                                what=f"{what}: dim {j} (base {b}), first {b**k} samples")
+            assert_one_per_closed_cell(candidates(x[:, : b**k, c], truncated_bounds(b**k)) + (b**k,),
+                                       what=f"{what}: dim {j} (base {b}), first {b**k} samples")
             k += 1
 
 
@@ -592,7 +748,7 @@ def test_halton_boundary_truncation_happens():
     x = grid(nb.halton, n, [1], np.arange(1, 2001, dtype=np.uint32) * 0x9E3779B1)[:, :, 0]
     naive = np.all(np.sort(np.floor(x.astype(np.float64) * n), axis=1) == np.arange(n), axis=1)
     assert not naive.all(), "no truncation onto a boundary in 2000 sets (expected a few)"
-    assert_one_per_cell(candidates(x, truncated_bounds(n)) + (n,), what="halton base 3, first 243")
+    assert_one_per_closed_cell(candidates(x, truncated_bounds(n)) + (n,), what="halton base 3, first 243")
 
 
 @given(p=seeds, j=st.integers(0, 6541), n=st.integers(1, 700))
@@ -609,8 +765,8 @@ def test_halton_2d_prefixes_of_dims_0_and_1():
     for a, c in [(1, 1), (2, 1), (3, 2), (4, 3), (6, 4)]:
         n = 2**a * 3**c
         x = grid(nb.halton, n, [0, 1], P_SEEDS)
-        assert_one_per_cell(candidates(x[:, :, 0], truncated_bounds(2**a)) + (2**a,),
-                            candidates(x[:, :, 1], truncated_bounds(3**c)) + (3**c,), f"halton {2**a}x{3**c}")
+        assert_one_per_closed_cell(candidates(x[:, :, 0], truncated_bounds(2**a)) + (2**a,),
+                                   candidates(x[:, :, 1], truncated_bounds(3**c)) + (3**c,), f"halton {2**a}x{3**c}")
 
 
 def test_halton_is_owen_scrambled_not_positional():
@@ -696,7 +852,7 @@ def test_reference_small_sets_are_stratified():
     check_halton(x, [0, 1, 2], "reference halton")
 
 
-# =============================================================================== unbiasedness (SPEC 8.6)
+# =============================================================================== unbiasedness (docs/spec.md 8.6)
 
 UNBIASED = [("random", 64), ("jittered2d", 64), ("cmj2d", 60), ("sobol02", 64), ("halton", 64), ("sobol", 64)]
 
@@ -800,7 +956,7 @@ def test_cmj2d_column_and_subrow_are_independent(N):
 def test_samplers_lists_the_six():
     names = pyoa.samplers()
     for name in NAMES:
-        assert name in names and names[name]
+        assert names.get(name)
 
 
 def test_valid_spp_catalogue():
@@ -942,4 +1098,4 @@ def test_cli_spp_and_samplers(capsys):
     code, out, _ = run_cli(["spp", "halton", "--limit", 3], capsys)
     assert code == 0 and "16777213 more" in out
     code, out, _ = run_cli(["samplers"], capsys)
-    assert code == 0 and all(re.search(rf"^{n}\s", out, re.M) for n in NAMES)
+    assert code == 0 and all(re.search(rf"^{n}\s", out, re.MULTILINE) for n in NAMES)

@@ -1,13 +1,15 @@
-"""SPEC sections 5, 6 and 8: the orthogonal-array properties of Bose and CMJND,
+"""docs/spec.md sections 5, 6 and 8: the orthogonal-array properties of Bose and CMJND,
 on the pure-Python reference (few seeds) and on the bulk API (many pixels, each
 an independently randomized array).
 
-Recovering the integer structure from float32 values: with jitter amount 0
-every point sits at the centre of its fine cell, far from any boundary, so
-``floor(x*s)`` is the stratum and ``floor(x*N)`` the fine cell exactly. With full
-jitter a value may round onto the upper boundary of its cell, so those values
-are checked against the closed cells of the jitter-0 run (same seed: jitter
-does not change the permutations).
+Recovering the integer structure from float32 values: every value is clamped
+into its fine cell, ``c/N <= x < (c+1)/N`` as real numbers (docs/spec.md section 7,
+:func:`pyoa.reference.floats.sample_value`), and ``x * N`` is exact in float64
+for a float32 ``x`` and ``N <= 2**24``, so ``floor(x*s)`` is the stratum and
+``floor(x*N)`` the fine cell exactly, at any jitter amount. The one exception
+is ``centered`` with an even number M of sub-strata: its sub-stratum (M-1)/2
+is a half-integer, the jitter-0 point lies on the edge between the two middle
+fine cells, and the value is clamped into its coarse stratum only.
 """
 
 from __future__ import annotations
@@ -24,23 +26,22 @@ from tests.helpers import (
     BB_S,
     U32_MAX,
     ak_constants_independent,
-    index2_symbol,
-    plain_ak_array,
-    plain_index2_array,
-    bush_sub_index,
-    bush_symbol,
-    field_for,
-    gf_bose_partner_symbol,
-    gf_bose_symbol,
-    plain_bush_array,
-    plain_gf_bose_array,
-    assert_latin_closed,
     assert_latin_exact,
     assert_oa,
     assert_same_bits,
     bose_partner_symbol,
     bose_symbol,
+    bush_sub_index,
+    bush_symbol,
+    field_for,
+    gf_bose_partner_symbol,
+    gf_bose_symbol,
     in_unit_interval,
+    index2_symbol,
+    plain_ak_array,
+    plain_bush_array,
+    plain_gf_bose_array,
+    plain_index2_array,
     strata_exact,
 )
 
@@ -52,7 +53,7 @@ CMJND_ST = [(s, t) for s in range(2, 7) for t in range(2, 5)]
 # ----------------------------------------------------------------------------- independent C oracle
 
 def test_reference_values_match_c_oracle(spec_c):
-    """pyoa.reference.bose / cmjnd against spec_hashes.c written from SPEC sections 3, 5-7."""
+    """pyoa.reference.bose / cmjnd against spec_hashes.c written from docs/spec.md sections 3, 5-7."""
     rng = np.random.default_rng(8)
     seeds = [0, 1, U32_MAX, U32_MAX - 1, 0x9E3779B9]
     rows = []
@@ -95,7 +96,7 @@ def test_bose_canonical_array_is_the_plain_bose_array(s):
             Ak = np.array([[bose_partner_symbol(i, j, s) for j in range(s + 1)] for i in range(N)])
             assert np.array_equal(np.floor(x.astype(np.float64) * N), A * s + Ak), offset
     assert_oa(A, s, 2, what=f"plain Bose s={s}")
-    # the plain array by its formula, written out for s = 3 (SPEC section 5)
+    # the plain array by its formula, written out for s = 3 (docs/spec.md section 5)
     if s == 3:
         assert A.T.tolist() == [[0, 0, 0, 1, 1, 1, 2, 2, 2],
                                 [0, 1, 2, 0, 1, 2, 0, 1, 2],
@@ -135,25 +136,31 @@ def _ref_array(fn, N, dims, **kw):
 
 
 def check_array(x0, x1, s, t, N, cols_blocks, offset, what):
-    """x0: jitter-0 values, x1: full-jitter values, shape (..., N, d)."""
+    """x0: jitter-0 values, x1: full-jitter values of the same arrays (jitter does
+    not change the permutations), shape (..., N, d); N = s * M fine cells."""
+    M, rem = divmod(N, s)  # every construction: s strata of M sub-strata each
+    assert rem == 0, what
     assert in_unit_interval(x0) and in_unit_interval(x1), what
     S = strata_exact(x0, s)
     for cols in cols_blocks:
         assert_oa(S, s, t, cols=cols, what=what)
     if offset in ("mj", "cmj"):
         assert_latin_exact(x0, N, what)
-        assert_latin_closed(x1, N, what)
+        assert_latin_exact(x1, N, what)
     if offset == "centered":
         assert_same_bits(x0, ((S + 0.5) / s).astype(np.float32), f"{what}: centred, jitter 0")
-    # full jitter stays inside the (closed) fine cell chosen by the permutations: the
-    # cell whose centre is the jitter-0 point (for `centered` with M even that centre
-    # is the middle of the coarse stratum, so the cell straddles two fine cells)
-    low = x0.astype(np.float64) * N - 0.5
-    pos = x1.astype(np.float64) * N - low
-    tol = 4 * N * 2.0**-24
-    assert pos.min() >= -tol and pos.max() <= 1 + tol, f"{what}: jitter leaves the fine cell"
+    if offset == "centered" and M % 2 == 0:
+        # sub-stratum (M-1)/2: x0 is the middle of its coarse stratum, on the edge
+        # between fine cells M/2 - 1 and M/2; full jitter stays in the coarse stratum
+        moved = np.count_nonzero(strata_exact(x1, s) != S)
+        assert moved == 0, f"{what}: full jitter moved {moved} values out of their coarse stratum"
+    else:
+        # full jitter stays inside the fine cell chosen by the permutations: the cell
+        # whose centre is the jitter-0 point
+        moved = np.count_nonzero(strata_exact(x1, N) != strata_exact(x0, N))
+        assert moved == 0, f"{what}: full jitter moved {moved} values out of their fine cell"
     # and it does jitter (not all at the centre)
-    assert np.abs(pos - 0.5).max() > 0.2 or N > 2**20, what
+    assert np.abs(x1.astype(np.float64) * N - x0.astype(np.float64) * N).max() > 0.2 or N > 2**20, what
 
 
 @pytest.mark.parametrize("s", BOSE_S)
@@ -184,7 +191,7 @@ N_PIXELS = 48
 
 
 def _bulk(name, spp, dims, backend, offset, strength=None, seed=0, n_pixels=N_PIXELS):
-    kw = dict(spp=spp, dims=dims, offset=offset, strength=strength, seed=seed, backend=backend)
+    kw = {"spp": spp, "dims": dims, "offset": offset, "strength": strength, "seed": seed, "backend": backend}
     pixels = list(range(n_pixels - 2)) + [U32_MAX - 1, U32_MAX]
     x0 = pyoa.sampler(name, jitter=0.0, **kw).generate(pixels=pixels)
     x1 = pyoa.sampler(name, jitter=1.0, **kw).generate(pixels=pixels)
@@ -288,7 +295,7 @@ def _canonical(fn, N, d, **kw):
 def test_gf_bose_canonical_array_is_the_plain_bose_array_over_gf(q):
     """Seed 0 is A_ij = a0 + (j-1) a1 in GF(q) (codes: base-p digits, modulus of
     KNOWN_MODULI), computed by an independent polynomial implementation; the fine
-    cell is A_ij*q + A_ik (partner column k, SPEC section 5); an OA(q^2, q+1, q, 2)."""
+    cell is A_ij*q + A_ik (partner column k, docs/spec.md section 5); an OA(q^2, q+1, q, 2)."""
     N, d = q * q, q + 1
     A, Ak = plain_gf_bose_array(q)
     F = field_for(q)  # spot check the vectorized array against the scalar definition
@@ -304,7 +311,7 @@ def test_gf_bose_canonical_array_is_the_plain_bose_array_over_gf(q):
 
 @pytest.mark.parametrize("q", [4, 8, 9, 16, 27])
 def test_integer_mod_q_is_not_an_oa_for_prime_powers(q):
-    """Why GF(q) is needed (SPEC section 5): the integer formula (a0 + (j-1) a1) mod q
+    """Why GF(q) is needed (docs/spec.md section 5): the integer formula (a0 + (j-1) a1) mod q
     is no OA for composite q, and the OA check above detects it."""
     A = np.array([[bose_symbol(i, j, q) for j in range(q + 1)] for i in range(q * q)])
     with pytest.raises(AssertionError, match="not an OA"):
@@ -312,7 +319,7 @@ def test_integer_mod_q_is_not_an_oa_for_prime_powers(q):
 
 
 def _bose_from_symbols(i, j, q, p, offset, jitter, symbol, partner):
-    """SPEC section 5 Bose value from independently computed symbols: ``symbol``
+    """docs/spec.md section 5 Bose value from independently computed symbols: ``symbol``
     and ``partner`` give A_ij and A_ik of column ``j < q+1``; seeds, offsets and
     floats use pyoa's hash and float primitives only."""
     block, j = divmod(j, q + 1)
@@ -328,7 +335,7 @@ def _bose_from_symbols(i, j, q, p, offset, jitter, symbol, partner):
 
 
 def _bose_mod_s(i, j, s, p, offset, jitter):
-    """The pre-GF Bose value (SPEC section 5, prime s), with plain mod-s integers."""
+    """The pre-GF Bose value (docs/spec.md section 5, prime s), with plain mod-s integers."""
     return _bose_from_symbols(i, j, s, p, offset, jitter,
                               lambda i, j: bose_symbol(i, j, s), lambda i, j: bose_partner_symbol(i, j, s))
 
@@ -349,14 +356,14 @@ def test_prime_bose_is_unchanged_by_gf(s):
 
 
 def _gf_bose_from_spec(i, j, q, p, offset, jitter):
-    """SPEC section 5 "Bose over GF(q)", with the independent field of tests.helpers."""
+    """docs/spec.md section 5 "Bose over GF(q)", with the independent field of tests.helpers."""
     F = field_for(q)
     return _bose_from_symbols(i, j, q, p, offset, jitter,
                               lambda i, j: gf_bose_symbol(i, j, F), lambda i, j: gf_bose_partner_symbol(i, j, F))
 
 
 def _bush_from_spec(i, j, s, t, p, offset, jitter):
-    """SPEC section 5 "Bush" (with pyoa's documented u = i mod M in column s),
+    """docs/spec.md section 5 "Bush" (with pyoa's documented u = i mod M in column s),
     with the independent field of tests.helpers."""
     F = field_for(s)
     M = s ** (t - 1)
@@ -379,7 +386,7 @@ def _same_f32(a, b):
 @pytest.mark.parametrize("q", [4, 8, 9, 16, 25, 27, 49, 256])
 def test_gf_bose_reference_follows_spec(q):
     """Whole values (permutations, offsets, jitter, blocks) of reference.bose over
-    GF(q) against SPEC section 5 written out with an independent GF(q)."""
+    GF(q) against docs/spec.md section 5 written out with an independent GF(q)."""
     rng = np.random.default_rng(q)
     for k in range(120):
         i, j = int(rng.integers(0, q * q)), int(rng.integers(0, 3 * (q + 1)))
@@ -394,7 +401,7 @@ def test_gf_bose_reference_follows_spec(q):
 @pytest.mark.parametrize("s, t", [(2, 2), (3, 3), (4, 4), (5, 5), (7, 3), (8, 8), (9, 2), (16, 6), (27, 3),
                                   (256, 3), (4093, 2)])
 def test_bush_reference_follows_spec(s, t):
-    """Whole values of reference.bush against SPEC section 5 (Bush) written out
+    """Whole values of reference.bush against docs/spec.md section 5 (Bush) written out
     with an independent GF(s), including column s, blocks and edge seeds."""
     rng = np.random.default_rng(s * 100 + t)
     N = s**t
@@ -716,7 +723,7 @@ def test_index2_latin_many_seeds(backend, name, s):
             assert_oa(strata_exact(x, s), s, 2)
 
 
-# ----------------------------------------------------------------------------- unbiasedness (SPEC 8.6)
+# ----------------------------------------------------------------------------- unbiasedness (docs/spec.md 8.6)
 
 def _f_cos(x):
     """prod_d (1 + 0.4 cos(2 pi x_d + d)): integral 1."""
@@ -745,7 +752,7 @@ def _f_step(x):
 )
 def test_estimates_are_unbiased(backend, name, spp, dims, strength, offset):
     """Mean over pixels (independent arrays) of the per-pixel estimate is within 5
-    standard errors of the integral. Not for `centered`: SPEC section 4 puts every
+    standard errors of the integral. Not for `centered`: docs/spec.md section 4 puts every
     point in the middle fine cell of its coarse stratum, which is not uniform on
     [0, 1) (see test_centered_offset_is_not_uniform)."""
     n_pixels = 3000
@@ -770,8 +777,8 @@ def test_unbiasedness_check_detects_a_biased_sampler():
 
 
 def test_centered_offset_is_not_uniform():
-    """SPEC section 4's `centered` only covers the middle fine cell of each coarse
-    stratum (sub = (M-1)/2), so it cannot be unbiased (SPEC 8.6 excludes it in effect)."""
+    """docs/spec.md section 4's `centered` only covers the middle fine cell of each coarse
+    stratum (sub = (M-1)/2), so it cannot be unbiased (docs/spec.md 8.6 excludes it in effect)."""
     s = 5
     x = pyoa.sampler("bose", spp=25, dims=3, offset="centered", backend="numpy").generate(pixels=range(50))
     frac = (x.astype(np.float64) * s) % 1
@@ -793,9 +800,9 @@ def test_reference_bush_refuses_bad_s_or_t(s, t):
 
 
 @pytest.mark.parametrize("kw, words", [
-    (dict(i=64), ["[0, 64)", "64"]), (dict(i=-1), ["[0, 64)"]), (dict(j=-1), ["dimension"]),
-    (dict(p=2**32), ["seed"]), (dict(p=-1), ["seed"]), (dict(offset="cj"), ["offset", "'cj'"]),
-    (dict(jitter=1.5), ["jitter"]), (dict(jitter=float("nan")), ["jitter"]),
+    ({"i": 64}, ["[0, 64)", "64"]), ({"i": -1}, ["[0, 64)"]), ({"j": -1}, ["dimension"]),
+    ({"p": 2**32}, ["seed"]), ({"p": -1}, ["seed"]), ({"offset": "cj"}, ["offset", "'cj'"]),
+    ({"jitter": 1.5}, ["jitter"]), ({"jitter": float("nan")}, ["jitter"]),
 ])
 def test_reference_bush_refuses_bad_arguments(kw, words):
     args = {"i": 0, "j": 0, "s": 4, "t": 3, "p": 0, "offset": "cmj", "jitter": 1.0, **kw}
@@ -824,9 +831,9 @@ def test_reference_bose_bush_refuses_unsupported_s(s):
 
 @pytest.mark.parametrize("fn, s", [(ref.addelman_kempthorne, 3), (ref.bose_bush, 4)])
 @pytest.mark.parametrize("kw, words", [
-    (dict(i="N"), ["[0, N)"]), (dict(i=-1), ["[0, N)"]), (dict(j=-1), ["dimension"]),
-    (dict(p=2**32), ["seed"]), (dict(p=-1), ["seed"]), (dict(offset="cj"), ["offset", "'cj'"]),
-    (dict(jitter=1.5), ["jitter"]), (dict(jitter=float("nan")), ["jitter"]),
+    ({"i": "N"}, ["[0, N)"]), ({"i": -1}, ["[0, N)"]), ({"j": -1}, ["dimension"]),
+    ({"p": 2**32}, ["seed"]), ({"p": -1}, ["seed"]), ({"offset": "cj"}, ["offset", "'cj'"]),
+    ({"jitter": 1.5}, ["jitter"]), ({"jitter": float("nan")}, ["jitter"]),
 ])
 def test_reference_index2_refuses_bad_arguments(fn, s, kw, words):
     N = 2 * s * s
