@@ -1,15 +1,20 @@
-"""Orthogonal-array samplers of SPEC section 5, one value at a time.
+"""Orthogonal-array samplers of docs/spec.md section 5, one value at a time.
 
 Each function returns ``x(i, j)``: dimension ``j`` of sample ``i`` of the
 array with seed ``p``, as a Python float holding a float32 value in
-``[0, 1)``. A value is built from one OA entry (SPEC section 1)::
+``[0, 1)``. A value is built from one OA entry (docs/spec.md section 1)::
 
     x = (stratum + (sub + jitter) / M) / s
 
 with ``stratum = permute(A_ij, s, P1_j)``, ``sub`` chosen by the offset style
-(SPEC section 4) and ``jitter = 0.5 + J * (randfloat(i, P3_j) - 0.5)``.
+(docs/spec.md section 4) and ``jitter = 0.5 + J * (randfloat(i, P3_j) - 0.5)``.
 Dimensions past a block of ``block_dims`` columns come from independently
-randomized copies of the array (SPEC section 6, :func:`~.hashes.block_seed`).
+randomized copies of the array (docs/spec.md section 6, :func:`~.hashes.block_seed`).
+
+Each sampler is split like ``pyoa._numpy.oa`` and ``kernels/oa.cl``: a
+``*_cell`` function gives the integer cell of sample ``i`` in column ``col``
+(``A_ij`` and the sub-stratum index ``u``; for Bose the partner entry
+``A_ik``), and one shared tail, :func:`_value`, turns a cell into ``x``.
 
 References
 ----------
@@ -43,7 +48,7 @@ def _check_common(i: int, N: int, j: int, p: int, offset: str, jitter: float) ->
 
 
 def _column(i: int, N: int, j: int, dmax: int, p: int, offset: str, jitter: float):
-    """Checks the arguments, then applies the block rule (SPEC section 6):
+    """Checks the arguments, then applies the block rule (docs/spec.md section 6):
     dimension ``j`` is column ``j % dmax`` of the copy with seed
     ``block_seed(p, j // dmax)``. Returns the float32 jitter amount, the
     column and its three seeds (stratum, sub-stratum, jitter)."""
@@ -58,7 +63,7 @@ def _centered(M: int) -> float:
 
 
 def _offset_sub(offset: str, u: int, M: int, cell_key: int, aij: int, P2: int) -> float:
-    """The sub-stratum of SPEC section 4: ``u`` (the point's index inside its
+    """The sub-stratum of docs/spec.md section 4: ``u`` (the point's index inside its
     coarse stratum, in ``[0, M)``) permuted with a seed per cell (``j``:
     ``cell_key * P2``), per stratum (``mj``: ``(A_ij + 1) * P2``) or per
     column (``cmj``: ``P2``); ``centered`` is ``(M - 1) / 2``. ``cell_key`` is
@@ -67,6 +72,15 @@ def _offset_sub(offset: str, u: int, M: int, cell_key: int, aij: int, P2: int) -
         return _centered(M)
     seed = {"j": cell_key * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset]
     return permute(u, M, seed & MASK)
+
+
+def _value(i: int, aij: int, u: int, P1: int, P2: int, P3: int, s: int, M: int, offset: str, J: float, cell_key: int) -> float:
+    """``x`` of sample ``i`` in cell ``(A_ij, u)``: stratum ``permute(A_ij, s, P1)``,
+    the offset's sub-stratum (:func:`_offset_sub`) among ``M`` and the jitter
+    of amount ``J`` seeded by ``P3`` (docs/spec.md sections 1 and 4)."""
+    stratum = permute(aij, s, P1)
+    sub = _offset_sub(offset, u, M, cell_key, aij, P2)
+    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
 
 
 def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -90,27 +104,27 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
     p : int
         Array seed (uint32); 0 is the canonical array.
     offset : {"cmj", "mj", "j", "centered"}
-        Offset style (SPEC section 4).
+        Offset style (docs/spec.md section 4).
     jitter : float
         Jitter amount J in [0, 1].
     """
     if not gf.is_supported(s):
         raise ValueError(f"bose needs s prime or a prime power <= {gf.MAX_TABLE_Q}, got s={s}")
-    J, j, (P1, P2, P3) = _column(i, s * s, j, s + 1, p, offset, jitter)
+    J, col, (P1, P2, P3) = _column(i, s * s, j, s + 1, p, offset, jitter)
+    aij, aik = bose_cell(i, col, s)
+    return _value(i, aij, aik, P1, P2, P3, s, s, offset, J, aik * s + aij + 1)
 
+
+def bose_cell(i: int, col: int, s: int) -> tuple[int, int]:
+    """``(A_ij, A_ik)`` of Bose column ``col < s + 1`` and its partner column
+    ``k``, over GF(s) (see :func:`bose`)."""
     a0, a1 = i // s, i % s
-    if j == 0:
-        aij, aik = a0, a1
-    elif j == 1:
-        aij, aik = a1, a0
-    else:
-        k = j - 1 if j % 2 else j + 1
-        aij = gf.add(a0, gf.mul(j - 1, a1, s), s)
-        aik = gf.add(a0, gf.mul((k - 1) % s, a1, s), s)
-
-    stratum = permute(aij, s, P1)
-    sub = _offset_sub(offset, aik, s, aik * s + aij + 1, aij, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), s, s)
+    if col == 0:
+        return a0, a1
+    if col == 1:
+        return a1, a0
+    k = col - 1 if col % 2 else col + 1
+    return gf.add(a0, gf.mul(col - 1, a1, s), s), gf.add(a0, gf.mul((k - 1) % s, a1, s), s)
 
 
 def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -139,18 +153,16 @@ def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: f
     if s < 2 or t < 1:
         raise ValueError(f"cmjnd needs s >= 2 and t >= 1, got s={s}, t={t}")
     N = s**t
-    J, j, (P1, P2, P3) = _column(i, N, j, t, p, offset, jitter)
-
-    M = N // s
-    sj = s**j
-    aij = (i // sj) % s
-    v = i % sj + (i // (sj * s)) * sj
-
-    stratum = permute(aij, s, P1)
-    sub = _offset_sub(offset, v, M, i + 1, aij, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
+    J, col, (P1, P2, P3) = _column(i, N, j, t, p, offset, jitter)
+    aij, v = cmjnd_cell(i, col, s)
+    return _value(i, aij, v, P1, P2, P3, s, N // s, offset, J, i + 1)
 
 
+def cmjnd_cell(i: int, col: int, s: int) -> tuple[int, int]:
+    """``(A_ij, v)`` of CMJND column ``col < t``: digit ``col`` of ``i`` in base
+    ``s`` and the number formed by the other digits (see :func:`cmjnd`)."""
+    sj = s**col
+    return (i // sj) % s, i % sj + (i // (sj * s)) * sj
 
 
 def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -193,22 +205,22 @@ def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: fl
     if not gf.is_supported(s) or not 2 <= t <= s:
         raise ValueError(f"bush needs s prime or a prime power <= {gf.MAX_TABLE_Q} and 2 <= t <= s, got s={s}, t={t}")
     N = s**t
-    J, j, (P1, P2, P3) = _column(i, N, j, s + 1, p, offset, jitter)
+    J, col, (P1, P2, P3) = _column(i, N, j, s + 1, p, offset, jitter)
+    aij, u = bush_cell(i, col, s, t)
+    return _value(i, aij, u, P1, P2, P3, s, N // s, offset, J, i + 1)
 
-    M = N // s
+
+def bush_cell(i: int, col: int, s: int, t: int) -> tuple[int, int]:
+    """``(A_ij, u)`` of Bush column ``col < s + 1``: the row polynomial at
+    ``col`` in GF(s) (its leading coefficient for ``col == s``) and the
+    sub-stratum index (see :func:`bush`)."""
     c = [(i // s**l) % s for l in range(t)]
-    if j < s:
-        aij = 0
-        for coeff in reversed(c):  # Horner: f(j) = (...(c_{t-1} j + c_{t-2}) j + ...) + c_0
-            aij = gf.add(gf.mul(aij, j, s), coeff, s)
-        u = i // s
-    else:
-        aij = c[t - 1]
-        u = i % M
-
-    stratum = permute(aij, s, P1)
-    sub = _offset_sub(offset, u, M, i + 1, aij, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
+    if col == s:
+        return c[t - 1], i % s ** (t - 1)
+    aij = 0
+    for coeff in reversed(c):  # Horner: f(col) = (...(c_{t-1} col + c_{t-2}) col + ...) + c_0
+        aij = gf.add(gf.mul(aij, col, s), coeff, s)
+    return aij, i // s
 
 
 def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -247,32 +259,30 @@ def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jit
     if pr is None or pr[0] == 2 or not gf.is_supported(q):
         raise ValueError(f"addelman-kempthorne needs q an odd prime, or odd prime power <= {gf.MAX_TABLE_Q}, got {q}")
     N = 2 * q * q
-    J, j, (P1, P2, P3) = _column(i, N, j, 2 * q + 1, p, offset, jitter)
+    J, col, (P1, P2, P3) = _column(i, N, j, 2 * q + 1, p, offset, jitter)
+    aij, u = addelman_kempthorne_cell(i, col, q)
+    return _value(i, aij, u, P1, P2, P3, q, 2 * q, offset, J, i + 1)
 
+
+def addelman_kempthorne_cell(i: int, col: int, q: int) -> tuple[int, int]:
+    """``(A_ij, u)`` of Addelman-Kempthorne column ``col < 2q + 1``, over GF(q)
+    (see the table of :func:`addelman_kempthorne`)."""
     kappa, b, k, c = gf.ak_constants(q)
     h, x, y = i // (q * q), (i // q) % q, i % q
     add, mul = (lambda a, b_: gf.add(a, b_, q)), (lambda a, b_: gf.mul(a, b_, q))
     x2 = mul(x, x)
-    if j == 0:
-        aij, u = y, h * q + x
-    elif j < q:
-        aij, u = add(add(x, mul(j, y)), b[j] if h else 0), h * q + y
-    elif j == q:
-        aij, u = add(y, mul(kappa, x2) if h else x2), h * q + x
-    elif j < 2 * q:
-        m = j - q
+    if col == 0:
+        return y, h * q + x
+    if col < q:
+        return add(add(x, mul(col, y)), b[col] if h else 0), h * q + y
+    if col == q:
+        return add(y, mul(kappa, x2) if h else x2), h * q + x
+    if col < 2 * q:
+        m = col - q
         if h:
-            aij = add(add(add(y, mul(k[m], x)), mul(kappa, x2)), c[m])
-        else:
-            aij = add(add(y, mul(m, x)), x2)
-        u = h * q + x
-    else:
-        aij, u = x, h * q + y
-
-    M = 2 * q
-    stratum = permute(aij, q, P1)
-    sub = _offset_sub(offset, u, M, i + 1, aij, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, q)
+            return add(add(add(y, mul(k[m], x)), mul(kappa, x2)), c[m]), h * q + x
+        return add(add(y, mul(m, x)), x2), h * q + x
+    return x, h * q + y
 
 
 def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -300,15 +310,15 @@ def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float
     if s < 2 or s & (s - 1) or 2 * s > gf.MAX_TABLE_Q:
         raise ValueError(f"bose-bush needs s a power of two with 2 <= s <= {gf.MAX_TABLE_Q // 2}, got {s}")
     N = 2 * s * s
-    J, j, (P1, P2, P3) = _column(i, N, j, 2 * s + 1, p, offset, jitter)
+    J, col, (P1, P2, P3) = _column(i, N, j, 2 * s + 1, p, offset, jitter)
+    aij, u = bose_bush_cell(i, col, s)
+    return _value(i, aij, u, P1, P2, P3, s, 2 * s, offset, J, i + 1)
 
+
+def bose_bush_cell(i: int, col: int, s: int) -> tuple[int, int]:
+    """``(A_ij, u)`` of Bose-Bush column ``col < 2s + 1``, computed in GF(2s)
+    (see :func:`bose_bush`)."""
     x, k = i // s, i % s
-    if j < 2 * s:
-        aij, u = (gf.mul(x, j, 2 * s) % s) ^ k, x
-    else:
-        aij, u = x % s, (x // s) * s + k
-
-    M = 2 * s
-    stratum = permute(aij, s, P1)
-    sub = _offset_sub(offset, u, M, i + 1, aij, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
+    if col < 2 * s:
+        return (gf.mul(x, col, 2 * s) % s) ^ k, x
+    return x % s, (x // s) * s + k
