@@ -1,15 +1,29 @@
-/* Integer hashes of SPEC sections 2 and 3 (mirrors pyoa/reference/hashes.py).
+/* Integer hashes of docs/spec.md sections 2 and 3 (mirrors pyoa/reference/hashes.py).
  * All arithmetic is uint with wrap-around. randfloat's float multiply must not
  * fuse with the subtraction in jitter_value once inlined (NVIDIA's compiler
  * did exactly that when this pragma came only later, in floats.cl), so the
  * pragma opens this file and program.source() puts it first in the program. */
 #pragma OPENCL FP_CONTRACT OFF
 
-#define STRATUM_KEY    0x51633e2du
-#define SUBSTRATUM_KEY 0x68bc21ebu
-#define JITTER_KEY     0x02e5be93u
-#define PIXEL_KEY      0x5bd1e995u
-#define BLOCK_KEY      0x1b873593u
+/* STRATUM_KEY, SUBSTRATUM_KEY, JITTER_KEY, PIXEL_KEY and BLOCK_KEY are not
+ * defined here: pyoa/_opencl/program.py's defines() passes them as -D build
+ * options (uint literals), generated from the constants of the same names in
+ * pyoa/reference/hashes.py, their only definition. */
+#ifndef STRATUM_KEY
+#error "STRATUM_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef SUBSTRATUM_KEY
+#error "SUBSTRATUM_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef JITTER_KEY
+#error "JITTER_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef PIXEL_KEY
+#error "PIXEL_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef BLOCK_KEY
+#error "BLOCK_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
 
 /* One pass of Kensler's bijection on [0, w] (the body of the cycle walk). */
 uint permute_round(uint i, uint p, uint w)

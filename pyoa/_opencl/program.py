@@ -1,8 +1,10 @@
 """Building pyoa's OpenCL program once per process and device.
 
-The sources of :mod:`pyoa.kernels` are concatenated in order, prefixed with
-the construction and offset codes of :mod:`pyoa.constructions` as ``-D``
-defines, and built with ``-cl-fp32-correctly-rounded-divide-sqrt`` (SPEC
+The sources of :mod:`pyoa.kernels` are concatenated in order and built with
+``-D`` defines carrying Python-side constants into them (:func:`defines`: the
+construction and offset codes of :mod:`pyoa.constructions`, the hash keys of
+:mod:`pyoa.reference.hashes` and :mod:`pyoa.reference.baselines`, which the
+``.cl`` files never copy) and ``-cl-fp32-correctly-rounded-divide-sqrt`` (SPEC
 section 7). Never add ``-cl-fast-relaxed-math`` or ``-cl-mad-enable``: they
 break bit-exactness. PoCL caches the compiled binary on disk (``~/.cache/pocl``),
 so later processes build fast.
@@ -19,6 +21,8 @@ import threading
 from importlib import resources
 
 from .. import constructions
+from ..reference import baselines as _ref_baselines
+from ..reference import hashes as _ref_hashes
 from .device import DeviceInfo
 
 BUILD_OPTIONS = ["-cl-fp32-correctly-rounded-divide-sqrt"]
@@ -27,10 +31,32 @@ _lock = threading.Lock()
 _cache: dict[tuple, tuple] = {}
 
 
+#: Modules whose ``*_KEY`` constants the kernels use under the same names:
+#: their only definition (kernels/hashes.cl and baselines.cl check, with
+#: ``#error``, that each one they use is defined).
+KEY_MODULES = (_ref_hashes, _ref_baselines)
+
+
+def kernel_keys() -> dict[str, int]:
+    """``name -> value`` of every ``*_KEY`` uint32 constant of :data:`KEY_MODULES`."""
+    keys: dict[str, int] = {}
+    for module in KEY_MODULES:
+        for name, value in vars(module).items():
+            if name.endswith("_KEY") and name.isupper() and isinstance(value, int):
+                if not 0 <= value <= 0xFFFFFFFF:
+                    raise ValueError(f"{module.__name__}.{name} = {value:#x} is not a uint32")
+                if keys.get(name, value) != value:
+                    raise ValueError(f"{name} has two values: {keys[name]:#x} and {value:#x} ({module.__name__})")
+                keys[name] = value
+    return keys
+
+
 def defines() -> list[str]:
-    """``-D`` options carrying the Python-side integer codes into the kernels."""
+    """``-D`` options carrying the Python-side integer codes and hash keys into
+    the kernels (keys as uint literals: ``-DSTRATUM_KEY=0x51633e2du``)."""
     opts = [f"-DOFFSET_{name.upper()}={code}" for name, code in constructions.OFFSET_CODES.items()]
     opts += [f"-DCONSTRUCTION_{c.function.upper()}={c.code}" for c in constructions.SAMPLERS.values()]
+    opts += [f"-D{name}=0x{value:08x}u" for name, value in kernel_keys().items()]
     return opts
 
 

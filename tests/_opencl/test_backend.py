@@ -96,3 +96,56 @@ def test_table_path_splits_long_axes_and_partial_pixels(monkeypatch, opencl, off
     assert any(r.n_k == n and r.n_pixels == 1 for r in launched)
     seams = [0, n // 2 - 1, n // 2, n // 2 + 1, 1343, 1344, n - 1]
     assert_same_bits(got[:, seams], reference_block(smp, pixels, seams, range(7)), "vs reference")
+
+
+# ----------------------------------------------------------------------------- hash keys: one definition
+
+#: Every hash key the kernels use, by the Python module that defines it.
+KERNEL_KEYS = {
+    "pyoa.reference.hashes": ("STRATUM_KEY", "SUBSTRATUM_KEY", "JITTER_KEY", "PIXEL_KEY", "BLOCK_KEY"),
+    "pyoa.reference.baselines": ("RANDOM_KEY", "PAD_KEY", "HALTON_KEY", "DIGIT_KEY", "SOBOL_KEY", "OWEN_KEY",
+                                 "SHUFFLE_KEY", "SUBX_KEY", "SUBY_KEY", "JITX_KEY", "JITY_KEY"),
+}
+
+
+def test_kernel_keys_are_build_defines_of_the_python_constants():
+    """The *_KEY values reach the kernels only as -D options generated from the
+    Python constants: the defines equal them, every key a kernel names is passed
+    and guarded by an #ifndef/#error, and no .cl file #defines a key itself."""
+    import importlib
+    import re
+    from importlib import resources
+
+    from pyoa import kernels
+    from pyoa._opencl import program
+
+    want = {name: getattr(importlib.import_module(module), name)
+            for module, names in KERNEL_KEYS.items() for name in names}
+    key_opts = [opt for opt in program.defines() if re.match(r"-D\w*_KEY=", opt)]
+    assert key_opts == [f"-D{name}=0x{value:08x}u" for name, value in want.items()]
+    got = {m[1]: int(m[2], 16) for m in (re.fullmatch(r"-D(\w+)=0x([0-9a-f]{8})u", opt) for opt in key_opts)}
+    assert got == want
+
+    cl_files = sorted(p for p in resources.files(kernels).iterdir() if p.name.endswith(".cl"))
+    assert {p.name for p in cl_files} >= set(kernels.SOURCES)
+    for path in cl_files:
+        text = path.read_text()
+        defined = re.findall(r"^\s*#\s*define\s+(\w*_KEY)\b", text, re.MULTILINE)
+        assert not defined, f"kernels/{path.name} defines {defined}: keys come from program.defines() only"
+    source = program.source()
+    assert set(re.findall(r"\b[A-Z][A-Z0-9_]*_KEY\b", source)) == set(want)
+    assert set(re.findall(r"^\s*#\s*ifndef\s+(\w+_KEY)\s*$", source, re.MULTILINE)) == set(want)
+
+
+@pytest.mark.parametrize("key", [name for names in KERNEL_KEYS.values() for name in names])
+def test_program_without_a_key_define_does_not_build(monkeypatch, opencl, key):
+    """A key missing from the build options stops the build with an #error naming it."""
+    from pyoa._opencl import program
+
+    options = [opt for opt in program.defines() if not opt.startswith(f"-D{key}=")]
+    assert len(options) == len(program.defines()) - 1
+    monkeypatch.setattr(program, "defines", lambda: options)
+    with pytest.raises(program.BuildError) as exc:
+        # a text of its own: neither served from nor left in the build cache
+        program.build(opencl.info, text=program.source() + f"\n/* built without {key} */\n")
+    assert f"{key} undefined" in exc.value.log
