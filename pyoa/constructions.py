@@ -7,7 +7,7 @@ many dimensions one independently randomized block holds, and the integer codes
 that the OpenCL kernels use for constructions and offset styles (passed to the
 kernel build as ``-D`` defines, so those codes live here only).
 
-The mathematics of each construction is in ``../shared/SPEC.md`` section 5 and
+The mathematics of each construction is in ``docs/spec.md`` section 5 and
 in the reference implementation :mod:`pyoa.reference`.
 
 Limits
@@ -15,7 +15,7 @@ Limits
 ``N <= 2**24`` samples per pixel: every integer that becomes a float (stratum,
 sub-stratum, ``M``, ``s``) is then exact in float32, and every product the
 constructions form (``s*s``, ``A_ik*s + A_ij + 1``, ``s**t``) stays below
-``2**32``, so the uint32 arithmetic of SPEC section 7 cannot overflow.
+``2**32``, so the uint32 arithmetic of docs/spec.md section 7 cannot overflow.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from typing import NamedTuple
 
 from . import gf
 
-#: Offset styles of SPEC section 4, in the order of their kernel codes.
+#: Offset styles of docs/spec.md section 4, in the order of their kernel codes.
 OFFSETS = ("centered", "j", "mj", "cmj")
 OFFSET_CODES = {name: code for code, name in enumerate(OFFSETS)}
 
@@ -41,7 +41,7 @@ MAX_SPP = 2**24
 #: Largest number of dimensions of one sampler (one row of values must fit in
 #: a single OpenCL buffer even for the largest request).
 MAX_DIMS = 2**20
-#: Largest user seed, pixel index: both are uint32 (SPEC section 3).
+#: Largest user seed, pixel index: both are uint32 (docs/spec.md section 3).
 MAX_UINT32 = 2**32 - 1
 
 
@@ -71,7 +71,7 @@ class SppChoice(NamedTuple):
         Strength t of the orthogonal array (every t-dimensional projection of
         one block is stratified into s**t cells).
     block_dims : int
-        Dimensions per independently randomized block (SPEC section 6).
+        Dimensions per independently randomized block (docs/spec.md section 6).
     detail : str
         For the comparison samplers, their grid (``"11x11"``, ``"2^7"``) or ``""``.
     """

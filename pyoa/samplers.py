@@ -274,7 +274,7 @@ class Sampler:
     block_dims : int
         Dimensions per independently randomized block (s+1 for Bose, t for CMJND,
         2 for padded samplers); dimensions past it come from re-randomized copies
-        (SPEC section 6).
+        (docs/spec.md section 6).
     offset : str or None
         Offset style of an OA sampler: ``"cmj"`` (default), ``"mj"``, ``"j"`` or
         ``"centered"``; None for the comparison samplers.
@@ -546,7 +546,7 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         Pixel ``k`` uses the array seed ``pyoa.reference.pixel_seed(seed, k)``.
     offset : {"cmj", "mj", "j", "centered"}, optional
         OA samplers only (default ``"cmj"``; the comparison samplers refuse
-        it). Where points go inside their coarse strata (SPEC section 4): ``cmj``
+        it). Where points go inside their coarse strata (docs/spec.md section 4): ``cmj``
         (correlated multi-jittered, the paper's "Ours") and ``mj`` are 1D Latin
         hypercubes; ``j`` jitters each coarse cell independently; ``centered``
         puts every point at the centre of its coarse stratum (up to jitter).
@@ -577,10 +577,13 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
     Examples
     --------
     >>> import pyoa
-    >>> smp = pyoa.sampler("bose", spp=121, dims=8, seed=7)
+    >>> smp = pyoa.sampler("bose", spp=121, dims=8, seed=7, backend="numpy")
     >>> x = smp.generate(pixels=range(4))
     >>> x.shape, x.dtype
     ((4, 121, 8), dtype('float32'))
+
+    Every value has the bits of the pure-Python reference:
+
     >>> bool(smp.value(pixel=3, i=17, j=5) == x[3, 17, 5])
     True
     """

@@ -4,7 +4,6 @@ stratification of one array."""
 
 from __future__ import annotations
 
-import doctest
 import itertools
 
 import numpy as np
@@ -321,8 +320,3 @@ def test_invalid_arguments():
     with pytest.raises(ValueError, match="'u_bounds' and 'l_bounds' must be integers"):
         eng.integers(1, u_bounds=1.5)
     assert eng.num_generated == 0
-
-
-def test_docstring_examples():
-    res = doctest.testmod(pyoa.qmc, verbose=False)
-    assert res.attempted > 10 and res.failed == 0
