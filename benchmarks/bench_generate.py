@@ -66,7 +66,7 @@ status.
 Noise
 -----
 On the 2-core PoCL machines this project is measured on, the same workload
-varies by 15-25 % from one process to the next (``/work/shared/POCL-NOTES.md``
+varies by 15-25 % from one process to the next (docs/performance.md, lessons for PoCL
 item 9). Compare figures taken within one invocation of this script (same
 process, interleaved runs); treat a difference between two invocations
 smaller than about 25 % as noise. The min/max columns show the spread inside

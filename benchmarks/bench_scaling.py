@@ -62,7 +62,7 @@ What is measured
 Noise
 -----
 On the 2-core PoCL machines this project is measured on, the same workload
-varies by 15-25 % from one process to the next (``/work/shared/POCL-NOTES.md``
+varies by 15-25 % from one process to the next (docs/performance.md, lessons for PoCL
 item 9), and a shared host can slow single runs by up to 2x. Read the shape of
 each curve within one report; treat differences under about 25 % between
 separate invocations as noise; the min/max columns (and the error bars in the

@@ -1,7 +1,7 @@
 """Galois fields GF(q), q = p**r, for the orthogonal-array constructions.
 
 Elements are integer *codes*: the base-p digits of a polynomial's
-coefficients, least significant digit = constant term (SPEC section 5), so
+coefficients, least significant digit = constant term (docs/spec.md section 5), so
 over a prime field (r = 1) the code is the residue itself and the arithmetic
 is plain mod-p arithmetic. Multiplication reduces modulo a fixed monic
 irreducible polynomial of degree r: for each q, the *first* one in the order

@@ -24,7 +24,7 @@ Profiles: ``ci`` (default: moderate ``max_examples``, no deadline), ``dev``
 C oracle
 --------
 The ``spec_c`` fixture compiles ``tests/reference/spec_hashes.c`` (an
-independent implementation of SPEC sections 2, 3, 5-7) with ``cc`` and
+independent implementation of docs/spec.md sections 2, 3, 5-7) with ``cc`` and
 returns a :class:`tests.helpers.SpecC` that answers queries in bulk.
 """
 

@@ -1,4 +1,4 @@
-"""SPEC section 8.4: every (pixel, sample, dimension) has the same float32 bits
+"""docs/spec.md section 8.4: every (pixel, sample, dimension) has the same float32 bits
 whichever backend computes it (OpenCL kernel == NumPy == pure-Python reference),
 in any batch. One suite over every sampler and backend: the ``backend`` fixture
 runs each test for "numpy" and "opencl"."""
@@ -373,7 +373,7 @@ def _find_clamped_sample(max_tries: int = 40):
 
 
 def test_value_that_rounds_to_one_is_clamped(backend):
-    """SPEC section 7 through the whole pipeline: the value is 0x3f7fffff in every backend."""
+    """docs/spec.md section 7 through the whole pipeline: the value is 0x3f7fffff in every backend."""
     pixel, i = _find_clamped_sample()
     smp = pyoa.sampler("cmjnd", spp=2**24, dims=24, seed=0, jitter=1.0, backend=backend)
     got = smp.generate(pixels=[pixel], samples=[i], dims=[0])

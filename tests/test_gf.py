@@ -3,7 +3,7 @@
 Checked against field axioms on the lookup tables (every prime power q <= 256
 that is not a prime; prime q use plain mod-q arithmetic), and against an
 independent polynomial implementation (tests.helpers.PolyField, Rabin's
-irreducibility test) for the moduli and the element codes of SPEC section 5.
+irreducibility test) for the moduli and the element codes of docs/spec.md section 5.
 """
 
 from __future__ import annotations
@@ -140,7 +140,7 @@ def test_addition_is_an_abelian_group(field):
 
 
 def test_addition_is_digitwise_mod_p(field):
-    """The element codes of SPEC section 5: addition adds the base-p digits mod p,
+    """The element codes of docs/spec.md section 5: addition adds the base-p digits mod p,
     so the characteristic is p (p copies of anything sum to 0)."""
     q, A, _ = field
     p, r = factor_prime_power(q)

@@ -1,4 +1,4 @@
-"""Integer hashes of SPEC sections 2 and 3 over NumPy uint32 arrays.
+"""Integer hashes of docs/spec.md sections 2 and 3 over NumPy uint32 arrays.
 
 Mirrors :mod:`pyoa.reference.hashes` operation for operation; NumPy's uint32
 arithmetic wraps modulo ``2**32`` as the spec requires. Arguments broadcast.

@@ -24,7 +24,7 @@ from .device import ENV_DEVICE, DeviceInfo, NoUsableDevice, candidates, list_dev
 
 #: What to do when a device's LLVM is older than the CPU: a PoCL built on a
 #: newer LLVM (Debian's pocl-opencl-icd: PoCL 3.1 on LLVM 15, which works on
-#: both CPUs of this machine kind, see POCL-NOTES.md).
+#: both CPUs of this machine kind, see docs/performance.md, lessons for PoCL).
 FIX_NEWER_POCL = "on Debian/Ubuntu: apt-get install pocl-opencl-icd (a PoCL with a newer LLVM)"
 FIX_OTHER_DEVICE = "choose another device with PYOA_OPENCL_DEVICE (list: pyoa backends)"
 

@@ -1,6 +1,6 @@
 """The pure-Python reference of pyoa: the oracle every backend is tested against.
 
-Scalar, one value at a time, written to be read next to ``SPEC.md``. It is
+Scalar, one value at a time, written to be read next to ``docs/spec.md``. It is
 slow by design; use :func:`pyoa.sampler` for bulk generation.
 
 Public functions: :func:`permute`, :func:`randfloat`, :func:`pixel_seed`,

@@ -7,7 +7,7 @@ function ``x(i, j)`` of the sample index ``i`` and dimension ``j`` of the
 point set with seed ``p`` (one pixel's set; :func:`~.hashes.pixel_seed`), so
 that any value can be computed alone and every backend gives the same bits.
 ``p == 0`` is the unrandomized set where one exists (cell centres in natural
-order, plain Halton and Sobol), as for the OAs (SPEC section 3).
+order, plain Halton and Sobol), as for the OAs (docs/spec.md section 3).
 
 **Padding** (``jittered2d``, ``cmj2d``, ``sobol02``): dimensions ``(0, 1),
 (2, 3), ...`` are pairs ``b = j // 2``, each an independent 2D point set with
@@ -18,7 +18,7 @@ of its samples, so different pairs are independent (Kensler's "padding").
 are ``k * 2**-24`` for an integer ``k < 2**24``: the 24 leading bits of the
 scrambled 32-bit (or base-``b``) fraction, exact in float32 and always below
 1. ``jittered2d`` and ``cmj2d`` use the OA samplers' float path
-(:func:`~.floats.sample_value`, SPEC section 7).
+(:func:`~.floats.sample_value`, docs/spec.md section 7).
 
 References
 ----------

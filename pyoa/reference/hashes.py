@@ -1,4 +1,4 @@
-"""Integer hashes of SPEC sections 2 and 3, one uint32 at a time.
+"""Integer hashes of docs/spec.md sections 2 and 3, one uint32 at a time.
 
 Every operation is on unsigned 32-bit integers with wrap-around; Python
 integers are unbounded, so each product is reduced with ``& MASK``.
@@ -17,13 +17,13 @@ from .floats import UNIT_SCALE, f32
 
 MASK = 0xFFFFFFFF
 
-#: Multipliers of the per-dimension seeds (SPEC section 3).
+#: Multipliers of the per-dimension seeds (docs/spec.md section 3).
 STRATUM_KEY = 0x51633E2D
 SUBSTRATUM_KEY = 0x68BC21EB
 JITTER_KEY = 0x02E5BE93
 
 #: Keys that separate the two uses of :func:`hash_pair` (pyoa's own choice,
-#: SPEC section 3 leaves the pixel and block hashes to the project).
+#: docs/spec.md section 3 leaves the pixel and block hashes to the project).
 PIXEL_KEY = 0x5BD1E995
 BLOCK_KEY = 0x1B873593
 
@@ -36,7 +36,7 @@ def permute(i: int, l: int, p: int) -> int:
     walking") until the result falls below ``l``. ``p == 0`` is the identity.
     The final shift is ``(i + p % l) % l`` rather than Kensler's
     ``(i + p) % l``, which stops being a permutation when ``i + p`` wraps
-    past ``2**32`` (SPEC section 2).
+    past ``2**32`` (docs/spec.md section 2).
 
     Parameters
     ----------
@@ -128,14 +128,14 @@ def hash_pair(a: int, b: int, key: int) -> int:
 def pixel_seed(seed: int, pixel: int) -> int:
     """The 32-bit array seed of one pixel: ``hash_pair(seed, pixel, 0x5bd1e995)``.
 
-    Never 0, so every pixel of a sampler is randomized (SPEC section 3); for
+    Never 0, so every pixel of a sampler is randomized (docs/spec.md section 3); for
     one user seed, distinct pixels get distinct seeds.
     """
     return hash_pair(seed, pixel, PIXEL_KEY)
 
 
 def block_seed(p: int, block: int) -> int:
-    """Seed of the ``block``-th copy of an array with seed ``p`` (SPEC section 6).
+    """Seed of the ``block``-th copy of an array with seed ``p`` (docs/spec.md section 6).
 
     Block 0 is the array itself (``p``); blocks 1, 2, ... get
     ``hash_pair(p, block, 0x1b873593)``: independent, never 0. Even the
@@ -146,7 +146,7 @@ def block_seed(p: int, block: int) -> int:
 
 
 def dimension_seeds(p: int, j: int) -> tuple[int, int, int]:
-    """Seeds of column ``j`` of an array with seed ``p`` (SPEC section 3):
+    """Seeds of column ``j`` of an array with seed ``p`` (docs/spec.md section 3):
     stratum permutation, sub-stratum permutation, jitter."""
     q = (p * (j + 1)) & MASK
     return (q * STRATUM_KEY) & MASK, (q * SUBSTRATUM_KEY) & MASK, (q * JITTER_KEY) & MASK

@@ -1,7 +1,7 @@
-"""SPEC sections 2 and 3: the integer hashes of the pure-Python reference.
+"""docs/spec.md sections 2 and 3: the integer hashes of the pure-Python reference.
 
 Expected values come from ``spec_hashes.c``, an independent C implementation
-written from SPEC.md (compiled at test time by the ``spec_c`` fixture), and
+written from docs/spec.md (compiled at test time by the ``spec_c`` fixture), and
 from a small table of golden values produced by that C program; never from
 pyoa's own output.
 """
@@ -48,7 +48,7 @@ GOLDEN_PERMUTE = [  # (i, l, p) -> permute(i, l, p)
     (6, 169, 42, 144),
     (123456, 2**23, 0xFFFFFFFA, 810870),
 ]
-#: The whole permutation of 0..6 with p = 0xfffffffe (SPEC section 2's example
+#: The whole permutation of 0..6 with p = 0xfffffffe (docs/spec.md section 2's example
 #: seed, where Kensler's unfixed (i + p) % l is not a permutation).
 GOLDEN_PERMUTATION_7 = [6, 1, 3, 2, 5, 0, 4]
 GOLDEN_RANDFLOAT_BITS = [  # (i, p) -> float32 bits of randfloat(i, p)
@@ -242,7 +242,7 @@ def test_randfloat_float_conversion_rounds_to_nearest_even(spec_c):
     assert [f32_bits(ref.randfloat(i, p)) for i in ins] == spec_c.randfloat_bits(ins, [p] * len(ins))
 
 
-# ----------------------------------------------------------------------------- seeds (SPEC section 3)
+# ----------------------------------------------------------------------------- seeds (docs/spec.md section 3)
 
 def test_pixel_seed_never_zero_even_when_the_hash_is_zero(spec_c):
     """mix32 is a bijection with mix32(0) == 0, so pixel = mix32(seed ^ key) makes the raw
@@ -288,7 +288,7 @@ def test_block_seed_zero_is_p_and_later_blocks_are_distinct_nonzero(p):
 
 
 def test_dimension_seeds_follow_spec_formula():
-    """SPEC section 3: p*(j+1)*K mod 2^32 for the three keys (j+1, not j)."""
+    """docs/spec.md section 3: p*(j+1)*K mod 2^32 for the three keys (j+1, not j)."""
     for p in (1, 0x9E3779B9, U32_MAX):
         for j in (0, 1, 12, 4093):
             q = p * (j + 1)
