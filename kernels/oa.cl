@@ -60,8 +60,9 @@ float oa_value(uint i, uint stratum, uint sub, uint P3, uint M, uint s, float J,
  * is the 'j' seed factor. */
 uint offset_sub(uint offset, uint u, uint M, uint cell_key, uint aij, uint P2)
 {
+    if (offset == OFFSET_CENTERED) return 0u;  /* skip the cycle walk it would discard */
     uint seed = (offset == OFFSET_J) ? cell_key * P2 : (offset == OFFSET_MJ) ? (aij + 1u) * P2 : P2;
-    return (offset == OFFSET_CENTERED) ? 0u : permute(u, M, seed);
+    return permute(u, M, seed);
 }
 
 float bose(uint i, uint j, uint s, uint p, uint offset, float J, __global const ushort *gf, uint tabled)

@@ -28,9 +28,8 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-import pyoa
 from pyoa._numpy import floats as numpy_floats
-from tests.helpers import assert_oa
+from tests.helpers import assert_oa, make
 
 #: Seeds: 0 (the canonical array), small, random and the largest uint32.
 SEEDS = [0, 1, 0x9E3779B9, 0xFFFFFFFF]
@@ -76,7 +75,7 @@ def assert_strata(x: np.ndarray, smp, what: str) -> None:
 
 
 def generate(name: str, spp: int, dims: int, pixels: int, backend: str, **kw) -> tuple[np.ndarray, object]:
-    smp = pyoa.sampler(name, spp=spp, dims=dims, backend=backend, **kw)
+    smp = make(name, spp, dims, backend=backend, **kw)
     return smp.generate(pixels=range(pixels)), smp
 
 

@@ -62,7 +62,7 @@ def sample_value(stratum, sub, jitter, M: int, s: int) -> np.ndarray:
     those outside. The kernels clamp every value instead (no branch); the
     conformance tests check that the two agree bit for bit.
     """
-    stratum = np.asarray(stratum).astype(U32)
+    stratum = np.asarray(stratum, dtype=U32)  # no copy when it is uint32 already
     sub = np.asarray(sub)
     x = (stratum.astype(F32) + (sub.astype(F32) + jitter) / F32(M)) / F32(s)
     shape = np.shape(x)
