@@ -25,23 +25,28 @@
 #error "BLOCK_KEY undefined: build with pyoa._opencl.program.defines()"
 #endif
 
-/* One pass of Kensler's bijection on [0, w] (the body of the cycle walk). */
-uint permute_round(uint i, uint p, uint w)
-{
-    i ^= p;             i *= 0xe170893du;
-    i ^= p >> 16;
-    i ^= (i & w) >> 4;
-    i ^= p >> 8;        i *= 0x0929eb3fu;
-    i ^= p >> 23;
-    i ^= (i & w) >> 1;  i *= 1u | (p >> 27);
-    i *= 0x6935fa69u;
-    i ^= (i & w) >> 11; i *= 0x74dcb303u;
-    i ^= (i & w) >> 2;  i *= 0x9e501cc3u;
-    i ^= (i & w) >> 2;  i *= 0xc860a3dfu;
-    i &= w;
-    i ^= i >> 5;
-    return i;
+/* One pass of Kensler's bijection on [0, w] (the body of the cycle walk).
+ * Defined once for scalars and once for 8-lane vectors (lanes with their own
+ * seeds, vector.cl), as DEFINE_FLOATS in floats.cl. */
+#define DEFINE_PERMUTE_ROUND(SFX, UT)                                                   \
+UT permute_round##SFX(UT i, UT p, uint w)                                               \
+{                                                                                       \
+    i ^= p;             i *= 0xe170893du;                                               \
+    i ^= p >> 16;                                                                       \
+    i ^= (i & w) >> 4;                                                                  \
+    i ^= p >> 8;        i *= 0x0929eb3fu;                                               \
+    i ^= p >> 23;                                                                       \
+    i ^= (i & w) >> 1;  i *= 1u | (p >> 27);                                            \
+    i *= 0x6935fa69u;                                                                   \
+    i ^= (i & w) >> 11; i *= 0x74dcb303u;                                               \
+    i ^= (i & w) >> 2;  i *= 0x9e501cc3u;                                               \
+    i ^= (i & w) >> 2;  i *= 0xc860a3dfu;                                               \
+    i &= w;                                                                             \
+    i ^= i >> 5;                                                                        \
+    return i;                                                                           \
 }
+DEFINE_PERMUTE_ROUND(, uint)
+DEFINE_PERMUTE_ROUND(_v8, uint8)
 
 /* w = the all-ones mask just covering l - 1 (the walk's domain [0, w]). */
 uint walk_mask(uint l)
@@ -68,19 +73,23 @@ uint permute(uint i, uint l, uint p)
 }
 
 /* Kensler's randfloat: float in [0, 1); 0.5 for p == 0. Written without an
- * early return (a select at the end) so that PoCL can vectorize callers. */
-float randfloat(uint i, uint p)
-{
-    i ^= p;
-    i ^= i >> 17;
-    i ^= i >> 10;  i *= 0xb36534e5u;
-    i ^= i >> 12;
-    i ^= i >> 21;  i *= 0x93fc4795u;
-    i ^= 0xdf6e307fu;
-    i ^= i >> 17;  i *= 1u | (p >> 18);
-    float r = convert_float_rte(i) * as_float(0x2f7ffffeu);
-    return p ? r : 0.5f;
+ * early return (a select at the end) so that PoCL can vectorize callers.
+ * Scalar and 8-lane (one seed for all lanes) instances, as above. */
+#define DEFINE_RANDFLOAT(SFX, UT, FT, CVT_RTE)                                          \
+FT randfloat##SFX(UT i, uint p)                                                         \
+{                                                                                       \
+    i ^= p;                                                                             \
+    i ^= i >> 17;                                                                       \
+    i ^= i >> 10;  i *= 0xb36534e5u;                                                    \
+    i ^= i >> 12;                                                                       \
+    i ^= i >> 21;  i *= 0x93fc4795u;                                                    \
+    i ^= 0xdf6e307fu;                                                                   \
+    i ^= i >> 17;  i *= 1u | (p >> 18);                                                 \
+    FT r = CVT_RTE(i) * as_float(0x2f7ffffeu);                                          \
+    return p ? r : (FT)0.5f;                                                            \
 }
+DEFINE_RANDFLOAT(, uint, float, convert_float_rte)
+DEFINE_RANDFLOAT(_v8, uint8, float8, convert_float8_rte)
 
 /* Wellons' lowbias32. */
 uint mix32(uint x)

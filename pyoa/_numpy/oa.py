@@ -221,8 +221,9 @@ def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     A cell depends on the sample and the column only, not on the pixel, so the
     table path computes it once per rectangle of pixels x samples and gathers
     the pixel's permutations with it (both backends; the OpenCL kernel
-    ``generate_cells`` reads exactly these arrays). ``u`` is 0 unless the
-    offset is ``cmj``, the only style that reads it on this path.
+    ``generate_cells`` reads exactly these arrays, and the vector path of
+    :mod:`pyoa._opencl.vector` the same, padded). ``u`` is 0 for the
+    ``centered`` offset, which has no sub-stratum.
     """
     prm = req.params
     i = req.samples[k0:k1][None, :]
@@ -230,7 +231,7 @@ def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     aij, u = CELLS[req.construction.name](i, col, prm)
     shape = (req.n_dims, k1 - k0)
     aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
-    if req.offset != "cmj":
+    if req.offset == "centered":
         return aij, np.zeros(shape, U32)
     return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
 

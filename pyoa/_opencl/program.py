@@ -60,15 +60,16 @@ def defines() -> list[str]:
     return opts
 
 
-def source() -> str:
-    """The whole program text, files in :data:`pyoa.kernels.SOURCES` order."""
+def source(names: tuple[str, ...] | None = None) -> str:
+    """The program text: the files ``names`` of :mod:`pyoa.kernels` (default
+    :data:`pyoa.kernels.SOURCES`), in that order."""
     from .. import kernels
 
     root = resources.files(kernels)
     # The pragma applies from where it appears to the end of the program:
     # first, so no float operation of any file can be contracted into an FMA.
     return "#pragma OPENCL FP_CONTRACT OFF\n" + "\n".join(
-        f"/* ---- {name} ---- */\n" + root.joinpath(name).read_text() for name in kernels.SOURCES
+        f"/* ---- {name} ---- */\n" + root.joinpath(name).read_text() for name in (names or kernels.SOURCES)
     )
 
 

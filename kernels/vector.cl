@@ -1,0 +1,159 @@
+/* The vector path: the orthogonal-array samplers' kernels specialized per
+ * request shape, built by pyoa/_opencl/vector.py after hashes.cl and
+ * floats.cl with these -D constants (docs/performance.md, "The vector
+ * path"):
+ *
+ *   VS, VM          s and M = N / s
+ *   VWS, VWM        walk masks of s and M (walk_mask in hashes.cl)
+ *   VND, VNK        dimensions and sample positions of the request
+ *   VNKP            VNK rounded up to whole blocks of 8
+ *   VDMAX           dimensions per block (docs/spec.md section 6)
+ *   VOFFSET         the offset's code (OFFSET_* of pyoa.constructions)
+ *   VS_PACKED       1: the stratum permutation is tabled as 4-bit fields
+ *                   (s <= 16); 0: each value walks it (VS_ROUNDS rounds)
+ *   VSUB            0 none ('centered'), 1 tabled as 4-bit fields ('cmj',
+ *                   M <= 16), 2 walked per value (VSUB_ROUNDS rounds)
+ *   VJKEY_BOSE      1: the 'j' seed factor is Bose's u * s + A_ij + 1, else i + 1
+ *   VSTORE_BLOCK, VSTORE_TAIL   the stores of one block (generated code)
+ *
+ * Why this shape (each measured on PoCL, docs/performance.md): the values
+ * kernel computes 8 sample positions of one pixel per work-item as explicit
+ * 8-lane vectors, for every dimension, and stores them as whole rows:
+ * across work-items, PoCL's own vectorization put the 8 lanes along the
+ * samples, and the store, with a stride of VND floats, then cost 40 % of the
+ * kernel; a (pixel, dimension)'s two permutations fit in 4-bit fields of
+ * two 32-bit words, read with a variable shift instead of two gathers; the
+ * walk of Kensler's permute is bounded (below), so no loop is left. */
+
+/* A bounded walk: the cycle of permute_round through i < l reaches a value
+ * below l after at most (w + 1 - l) values at or above l, so w + 2 - l
+ * rounds always end it (and the host only builds this path when that is at
+ * most MAX_ROUNDS of pyoa/_opencl/vector.py). Lanes that are done keep
+ * their value. Then the final shift of permute (hashes.cl). Lanes with p == 0
+ * are the identity. */
+uint8 permute_bounded_v8(uint8 i, uint8 p, uint l, uint w, uint rounds)
+{
+    uint8 x = permute_round_v8(i, p, w);
+    #pragma unroll
+    for (uint r = 1u; r < rounds; ++r)  /* rounds is a build constant: unrolled */
+        x = (x < l) ? x : permute_round_v8(x, p, w);
+    x += p % l;
+    x = (x >= l) ? x - l : x;
+    return (p != 0u) ? x : i;
+}
+
+/* Entry a (< 16) of a permutation stored as 4-bit fields: 0..7 in lo, 8..15 in hi. */
+uint field4(uint lo, uint hi, uint a) { return ((a < 8u ? lo : hi) >> ((a & 7u) * 4u)) & 15u; }
+uint8 field4_v8(uint lo, uint hi, uint8 a) { return (((a < 8u) ? (uint8)lo : (uint8)hi) >> ((a & 7u) * 4u)) & 15u; }
+
+/* The permutation of [0, l) with seed p (l <= w + 1 <= 16) as 4-bit fields:
+ * permute_round of every x in [0, w] once, then each entry's bounded walk
+ * through that table, then the final shift. */
+void permutation_fields(uint l, uint w, uint p, uint *lo_out, uint *hi_out)
+{
+    uint rlo = 0u, rhi = 0u;
+    #pragma unroll
+    for (uint x = 0u; x <= w; ++x) {  /* unrolled: w is a build constant */
+        uint r = permute_round(x, p, w) << (4u * (x & 7u));
+        rlo |= (x < 8u) ? r : 0u;
+        rhi |= (x < 8u) ? 0u : r;
+    }
+    uint sh = p % l, lo = 0u, hi = 0u;
+    #pragma unroll
+    for (uint i = 0u; i < l; ++i) {
+        uint y = field4(rlo, rhi, i);
+        #pragma unroll
+        for (uint st = 0u; st + l < w + 1u; ++st)
+            y = (y < l) ? y : field4(rlo, rhi, y);
+        y += sh;
+        y = (y >= l) ? y - l : y;
+        y = (p ? y : i) << (4u * (i & 7u));
+        lo |= (i < 8u) ? y : 0u;
+        hi |= (i < 8u) ? 0u : y;
+    }
+    *lo_out = lo;
+    *hi_out = hi;
+}
+
+/* Per (pixel, dimension) pd of the launch, 8 words at pk[8 pd]: [0, 1] the
+ * stratum permutation as fields (VS_PACKED) or [0] its seed; [2, 3] the
+ * sub-stratum permutation as fields (VSUB == 1) or [2] its seed; [4] the
+ * jitter seed. The keys come from the pixel and dimension numbers here
+ * (docs/spec.md sections 3 and 6), not from the host. One work-item per pd:
+ * PoCL vectorizes across them. */
+__kernel void vector_tables(__global uint *restrict pk,
+                            __global const uint *restrict pixels,
+                            __global const uint *restrict dims,
+                            const uint seed)
+{
+    uint pd = (uint)get_global_id(0);
+    uint j = dims[pd % VND];
+    uint q = block_seed(pixel_seed(seed, pixels[pd / VND]), j / VDMAX) * (j % VDMAX + 1u);
+    uint w0 = q * STRATUM_KEY, w1 = 0u, w2 = q * SUBSTRATUM_KEY, w3 = 0u;
+#if VS_PACKED
+    permutation_fields(VS, VWS, q * STRATUM_KEY, &w0, &w1);
+#endif
+#if VSUB == 1
+    permutation_fields(VM, VWM, q * SUBSTRATUM_KEY, &w2, &w3);
+#endif
+    __global uint *o = pk + 8u * pd;
+    o[0] = w0; o[1] = w1; o[2] = w2; o[3] = w3; o[4] = q * JITTER_KEY;
+}
+
+/* Values of sample positions [8 b, 8 b + 8) of pixel pl (axis 0: b, axis 1:
+ * pl), every dimension, written at out + out0 + (pl * VNK + 8 b) * VND. cell_a
+ * and cell_u are the cells of docs/spec.md section 5 laid out [d][k] with rows
+ * of VNKP (pyoa._numpy.oa.cells, padded), isamp the sample indices (padded). */
+__kernel void vector_values(__global float *restrict out,
+                            const uint out0,
+                            __global const uint *restrict pk,
+                            __global const uint *restrict cell_a,
+                            __global const uint *restrict cell_u,
+                            __global const uint *restrict isamp,
+                            const float J)
+{
+    uint b = (uint)get_global_id(0), pl = (uint)get_global_id(1);
+    uint8 i = vload8(b, isamp);
+    float8 V[VND];
+    #pragma unroll
+    for (uint d = 0u; d < VND; ++d) {  /* VND is a build constant: unrolled */
+        __global const uint *w = pk + 8u * (pl * VND + d);
+        uint8 aij = vload8(b, cell_a + d * VNKP);
+#if VS_PACKED
+        uint8 stratum = field4_v8(w[0], w[1], aij);
+#else
+        uint8 stratum = permute_bounded_v8(aij, (uint8)w[0], VS, VWS, VS_ROUNDS);
+#endif
+        float8 jit = jitter_value_v8(randfloat_v8(i, w[4]), J);
+#if VSUB == 0
+        V[d] = centered_value_v8(stratum, jit, VM, VS);
+#else
+        uint8 u = vload8(b, cell_u + d * VNKP);
+#if VSUB == 1
+        uint8 sub = field4_v8(w[2], w[3], u);
+#else
+#if VOFFSET == OFFSET_J
+#if VJKEY_BOSE
+        uint8 seed = (u * VS + aij + 1u) * w[2];
+#else
+        uint8 seed = (i + 1u) * w[2];
+#endif
+#elif VOFFSET == OFFSET_MJ
+        uint8 seed = (aij + 1u) * w[2];
+#else
+        uint8 seed = (uint8)w[2];
+#endif
+        uint8 sub = permute_bounded_v8(u, seed, VM, VWM, VSUB_ROUNDS);
+#endif
+        V[d] = sample_value_v8(stratum, sub, jit, VM, VS);
+#endif
+    }
+    __global float *o = out + out0 + (pl * VNK + 8u * b) * VND;
+#if VNK % 8
+    if (b + 1u == VNKP / 8u) {
+        VSTORE_TAIL
+        return;
+    }
+#endif
+    VSTORE_BLOCK
+}

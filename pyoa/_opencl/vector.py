@@ -1,0 +1,186 @@
+"""The vector path: orthogonal-array kernels specialized per request shape.
+
+``kernels/vector.cl`` is built once per *shape* (construction parameters,
+offset, number of dimensions and of sample positions), with the shape's
+numbers as ``-D`` constants, so that every loop in it has a constant trip
+count and unrolls, and its stores are generated for exactly that row length
+(:func:`store_code`). A shape is built on first use in a process (about
+0.3 s, plus PoCL's compilation of the two kernels on their first launch,
+which PoCL caches on disk across processes: docs/performance.md, "The
+vector path"), then reused from :data:`_programs`.
+
+Which requests take it (:func:`shape`): the orthogonal-array samplers, any
+offset, when
+
+- a rectangle is whole pixels with at least 8 sample positions (the tables,
+  32 bytes per pixel and dimension, are then no larger than the output),
+- there are at most :data:`MAX_DIMS` dimensions (the kernel holds one
+  vector per dimension),
+- the stratum permutation fits 4-bit fields (s <= 16) or its bounded walk
+  takes at most :data:`MAX_ROUNDS` rounds, and the sub-stratum permutation
+  likewise ('cmj' with M <= 16 is tabled; 'mj', 'j' and larger 'cmj' walk per
+  value).
+
+A walk of Kensler's permute on [0, l) in the domain [0, w] ends after at most
+w + 2 - l rounds (the cycle through the start meets at most w + 1 - l values
+outside [0, l) first), so the kernels run exactly that many rounds, without a
+loop: l = 11 (w = 15) takes 6, l = 17 (w = 31) 16. Everything else takes the
+table path or the direct path of ``kernels/generate.cl``, with the same bits.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import constructions
+from ..request import Rect, Request
+
+#: Lanes per vector: 8 (AVX2's width; on AVX-512, 16 lanes measured slower).
+LANES = 8
+#: Most dimensions of a request on this path.
+MAX_DIMS = 16
+#: Most rounds of a bounded walk (l = 17 in [0, 31] needs 16).
+MAX_ROUNDS = 16
+#: Words of the per-(pixel, dimension) table (kernels/vector.cl, vector_tables).
+TABLE_WORDS = 8
+
+
+def walk_mask(n: int) -> int:
+    """The all-ones mask just covering ``n - 1`` (``walk_mask`` of hashes.cl)."""
+    return (1 << (n - 1).bit_length()) - 1
+
+
+def walk_rounds(n: int) -> int:
+    """Rounds that always end a walk of Kensler's permute on ``[0, n)``."""
+    return walk_mask(n) + 2 - n
+
+
+@dataclass(frozen=True)
+class Shape:
+    """The build constants of one vector program (see kernels/vector.cl)."""
+
+    s: int
+    M: int
+    n_dims: int
+    n_k: int
+    block_dims: int
+    offset: str
+    s_packed: bool
+    sub: int  # 0 none, 1 tabled as fields, 2 walked per value
+    jkey_bose: bool
+
+    @property
+    def n_blocks(self) -> int:
+        return -(-self.n_k // LANES)
+
+    @property
+    def n_k_padded(self) -> int:
+        return self.n_blocks * LANES
+
+    def header(self) -> str:
+        """The ``#define`` lines that open the program text (the generated
+        stores do not fit ``-D`` options, which the driver splits at spaces)."""
+        block, tail = store_code(self.n_dims, self.n_k % LANES)
+        consts = {
+            "VS": f"{self.s}u", "VM": f"{self.M}u", "VWS": f"{walk_mask(self.s)}u", "VWM": f"{walk_mask(self.M)}u",
+            "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
+            "VDMAX": f"{self.block_dims}u", "VOFFSET": constructions.OFFSET_CODES[self.offset],
+            "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
+            "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
+            "VSTORE_BLOCK": block, "VSTORE_TAIL": tail,
+        }
+        return "".join(f"#define {name} {value}\n" for name, value in consts.items())
+
+
+def shape(req: Request, rect: Rect) -> Shape | None:
+    """The vector program for rectangle ``rect`` of ``req``, or None when the
+    rectangle does not take the vector path (module docstring)."""
+    prm = req.params
+    if req.construction.family == "baseline" or rect.n_k != len(req.samples) or rect.n_k < LANES:
+        return None
+    if not 1 <= req.n_dims <= MAX_DIMS:
+        return None
+    s_packed = prm.s <= 16
+    if not s_packed and walk_rounds(prm.s) > MAX_ROUNDS:
+        return None
+    if req.offset == "centered":
+        sub = 0
+    elif req.offset == "cmj" and prm.M <= 16:
+        sub = 1
+    elif walk_rounds(prm.M) <= MAX_ROUNDS:
+        sub = 2
+    else:
+        return None
+    return Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
+                 req.construction.name == "bose")
+
+
+def store_code(n_dims: int, tail: int) -> tuple[str, str]:
+    """OpenCL statements storing ``float8 V[n_dims]`` (V[d] lane r is sample
+    8 b + r of dimension d) at ``o``, row after row (``o[r * n_dims + d]``).
+
+    The full block is ``n_dims`` contiguous ``vstore8`` of the rows in order:
+    elements gathered from the V[d] by constant indices, which LLVM turns
+    into shuffles. The tail block (``tail`` valid rows, 0 = none) stores its
+    ``tail * n_dims`` values one by one."""
+    def elem(m: int) -> str:
+        r, d = divmod(m, n_dims)
+        return f"V[{d}].s{r}"
+
+    block = " ".join(
+        f"vstore8((float8)({', '.join(elem(v * LANES + e) for e in range(LANES))}), {v}, o);"
+        for v in range(n_dims)
+    )
+    tail_code = " ".join(f"o[{m}] = {elem(m)};" for m in range(tail * n_dims)) or ";"
+    return block, tail_code
+
+
+_lock = threading.Lock()
+#: (context, Shape) -> built program with its two kernels.
+_programs: dict[tuple, tuple] = {}
+
+
+def kernels(context, info, shp: Shape) -> tuple:
+    """``(vector_tables, vector_values)`` built for ``shp`` in ``context``,
+    once per process.
+
+    Raises
+    ------
+    pyoa._opencl.program.BuildError
+        If the device's compiler rejects the program (it carries the log).
+    """
+    import pyopencl as cl
+
+    from .. import kernels as kernel_sources
+    from . import program
+
+    key = (context.int_ptr, shp)
+    with _lock:
+        if key not in _programs:
+            printed: list[str] = []
+            try:
+                with program._captured_stderr() as printed:
+                    prg = cl.Program(context, shp.header() + program.source(kernel_sources.VECTOR_SOURCES)).build(
+                        options=program.BUILD_OPTIONS + program.defines())
+            except cl.Error as exc:
+                noise = "".join(printed)
+                raise program.BuildError(info, "build", str(exc) + (f"\n{noise}" if noise.strip() else "")) from exc
+            _programs[key] = (cl.Kernel(prg, "vector_tables"), cl.Kernel(prg, "vector_values"))
+        return _programs[key]
+
+
+def cell_arrays(req: Request, shp: Shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(A_ij, u, sample indices)`` of every sample position, the cells laid
+    out ``[d][k]`` and every row padded with zeros to whole blocks (the
+    kernel's ``vload8`` reads whole blocks; padded lanes are never stored)."""
+    from .._numpy.oa import cells
+
+    aij, u = cells(req, 0, shp.n_k)
+    pad = shp.n_k_padded - shp.n_k
+    samples = np.pad(req.samples, (0, pad))
+    return (np.ascontiguousarray(np.pad(aij, ((0, 0), (0, pad)))),
+            np.ascontiguousarray(np.pad(u, ((0, 0), (0, pad)))),
+            np.ascontiguousarray(samples, dtype=np.uint32))
