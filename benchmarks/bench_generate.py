@@ -19,6 +19,13 @@ user pays for one bulk request: argument validation, allocation of the
 float32 ``(P, spp, dims)`` result, every chunk's launch or NumPy evaluation,
 and (OpenCL) the device-to-host copy.
 
+The ``fill`` backend row times NumPy's ``ndarray.fill`` into the same
+result array: the rate at which the machine writes float32 values at all.
+The ``of fill`` column divides every rate (pyoa's and the peers') by the fill
+rate of the same case in the same run; the generation goals are stated as
+such fractions (docs/performance.md), because the machine's speed drifts
+between processes and differs between CPUs.
+
 Reported per case and backend: the value count ``P * spp * dims``, the median,
 minimum and maximum of the timed runs, and the throughput
 ``values / median seconds`` in millions of float32 values per second. The
@@ -162,7 +169,28 @@ REQUIRED_CASE = "bose-cmj-121x10"
 #: dominates), over the 5-minute budget for a default run, so only the
 #: required case runs by default; ``--cases all`` runs every case.
 DEFAULT_CASES = (REQUIRED_CASE,)
-BACKENDS = ("opencl", "numpy")
+BACKENDS = ("opencl", "numpy", "fill")
+
+
+class _Fill:
+    """The ``fill`` row: NumPy's ``ndarray.fill`` into the same result array,
+    the rate at which this machine can write float32 values at all (memory
+    bandwidth). The generation goals are fractions of it, measured in the
+    same run (docs/performance.md)."""
+
+    device = "NumPy ndarray.fill (memory-bandwidth ceiling)"
+    s = strength = None
+
+    def __init__(self, shape: tuple):
+        self.shape = shape
+
+    def __repr__(self) -> str:
+        return f"ndarray.fill{self.shape}"
+
+    def generate(self, pixels, out=None):
+        x = np.empty(self.shape, np.float32) if out is None else out
+        x.fill(0.5)
+        return x
 
 
 # ---------------------------------------------------------------------------
@@ -224,7 +252,7 @@ def prepare(case: str, backend: str, pixels: int, seed: int, fresh: bool = False
         t0 = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("error", pyoa.PyoaFallbackWarning)  # never a silent fallback
-            smp = pyoa.sampler(spec["name"], spp=spec["spp"], dims=spec["dims"], seed=seed,
+            smp = _Fill((pixels, spec["spp"], spec["dims"])) if name == "fill" else pyoa.sampler(spec["name"], spp=spec["spp"], dims=spec["dims"], seed=seed,
                                offset=spec["offset"], strength=spec["strength"], backend=name, device=device)
         entry["setup_s"] = time.perf_counter() - t0
     except Exception as exc:  # noqa: BLE001 - an unusable backend is reported, not fatal
@@ -345,15 +373,17 @@ def peers_markdown(report: dict) -> list[str]:
         f"full workload ({FULL_PIXELS:,} pixels x {spec['spp']} x {spec['dims']}) would take at the peer's rate. "
         f"Mitsuba: {cfg['peer_pixels']:,} pixels in one wavefront per run, median of {runs} after a warm-up.",
         "",
-        f"| peer | status | M values/s | pyoa OpenCL / peer | pyoa NumPy / peer | est. s, {FULL_PIXELS:,} px | "
+        f"| peer | status | M values/s | of fill | pyoa OpenCL / peer | pyoa NumPy / peer | est. s, {FULL_PIXELS:,} px | "
         "details |",
-        "|---|---|---:|---:|---:|---:|---|",
+        "|---|---|---:|---:|---:|---:|---:|---|",
     ]
+    fill = pyoa_rate.get("fill")
     for p in report["peers"]:
         rate = p["values_per_s"]
         full = p["details"].get("full_workload_s")
         lines.append(
             f"| {p['name']} | {p['status']} | {_rate(rate) if rate else ''} | "
+            f"{f'{rate / fill:.3f}' if rate and fill else ''} | "
             f"{_ratio(pyoa_rate.get('opencl'), rate)} | {_ratio(pyoa_rate.get('numpy'), rate)} | "
             f"{f'{full:,.1f}' if full else ''} | {_peer_details(p)} |"
         )
@@ -376,20 +406,23 @@ def markdown(report: dict) -> str:
         "; M values/s = values / median seconds. Process-to-process noise "
         "on this machine kind is 15-25 %: compare rows of this table, not separate runs.",
         "",
-        "| case | backend | values | median s | M values/s | min s | max s | spread | vs numpy |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| case | backend | values | median s | M values/s | min s | max s | spread | vs numpy | of fill |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     numpy_rate = {r["case"]: r.get("median_values_per_s") for r in report["results"] if r["backend"] == "numpy"}
+    fill_rate = {r["case"]: r.get("median_values_per_s") for r in report["results"] if r["backend"] == "fill"}
     for r in report["results"]:
         if "median_s" not in r:
-            lines.append(f"| {r['case']} | {r['backend']} | {r['values']:,} | {r['status']} | | | | | |")
+            lines.append(f"| {r['case']} | {r['backend']} | {r['values']:,} | {r['status']} | | | | | | |")
             continue
         base = numpy_rate.get(r["case"])
-        ratio = f"{r['median_values_per_s'] / base:.1f}x" if base and r["backend"] != "numpy" else ""
+        ratio = f"{r['median_values_per_s'] / base:.1f}x" if base and r["backend"] not in ("numpy", "fill") else ""
+        fill = fill_rate.get(r["case"])
+        of_fill = f"{r['median_values_per_s'] / fill:.3f}" if fill and r["backend"] != "fill" else ""
         lines.append(
             f"| {r['case']} | {r['backend']} | {r['values']:,} | {r['median_s']:.3f} | "
             f"{_m(r['median_values_per_s'])} | {r['min_s']:.3f} | {r['max_s']:.3f} | "
-            f"{100 * r['spread']:.0f} % | {ratio} |"
+            f"{100 * r['spread']:.0f} % | {ratio} | {of_fill} |"
         )
     notes = [f"- {r['case']} / {r['backend']}: {r['status']}: {r['reason']}"
              for r in report["results"] if r["status"] != "ok"]
@@ -445,7 +478,8 @@ def parse_args(argv=None) -> argparse.Namespace:
         description="Time pyoa Sampler.generate per backend (median of N runs after one warm-up).",
     )
     ap.add_argument("--backends", type=_csv(BACKENDS, "backend"), default=",".join(BACKENDS),
-                    help="comma-separated backends (default: opencl,numpy)")
+                    help="comma-separated backends; 'fill' is NumPy's ndarray.fill into the same array, the "
+                         "memory-bandwidth ceiling the 'of fill' column divides by (default: opencl,numpy,fill)")
     ap.add_argument("--cases", type=_csv(tuple(CASES), "case", extra={"all": tuple(CASES),
                                                                        "default": DEFAULT_CASES,
                                                                        "baselines": BASELINE_CASES}),
@@ -526,8 +560,9 @@ def main(argv=None) -> int:
     meta["loadavg_start"], meta["loadavg_end"] = load_start, loadavg()
     bits_match = {}
     for case in args.cases:
-        digests = {r["digest"] for r in results if r["case"] == case and r.get("digest")}
-        if sum(1 for r in results if r["case"] == case and r.get("digest")) > 1:
+        mine = [r for r in results if r["case"] == case and r.get("digest") and r["backend"] != "fill"]
+        digests = {r["digest"] for r in mine}
+        if len(mine) > 1:
             bits_match[case] = len(digests) == 1
 
     report = {

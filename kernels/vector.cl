@@ -42,34 +42,32 @@ uint8 permute_bounded_v8(uint8 i, uint8 p, uint l, uint w, uint rounds)
     return (p != 0u) ? x : i;
 }
 
-/* Entry a (< 16) of a permutation stored as 4-bit fields: 0..7 in lo, 8..15 in hi. */
-uint field4(uint lo, uint hi, uint a) { return ((a < 8u ? lo : hi) >> ((a & 7u) * 4u)) & 15u; }
-uint8 field4_v8(uint lo, uint hi, uint8 a) { return (((a < 8u) ? (uint8)lo : (uint8)hi) >> ((a & 7u) * 4u)) & 15u; }
+/* Entries a (< 16) of permutations stored as 4-bit fields: 0..7 in lo, 8..15 in hi. */
+uint8 field4_v8(uint8 lo, uint8 hi, uint8 a) { return (((a < 8u) ? lo : hi) >> ((a & 7u) * 4u)) & 15u; }
 
-/* The permutation of [0, l) with seed p (l <= w + 1 <= 16) as 4-bit fields:
- * permute_round of every x in [0, w] once, then each entry's bounded walk
- * through that table, then the final shift. */
-void permutation_fields(uint l, uint w, uint p, uint *lo_out, uint *hi_out)
+/* The permutations of [0, l) with seeds p (l <= w + 1 <= 16), one per lane,
+ * as 4-bit fields: permute_round of every x in [0, w] once, then each
+ * entry's bounded walk through that table (at most w + 1 - l steps, see
+ * permute_bounded_v8), then the final shift. */
+void permutation_fields_v8(uint l, uint w, uint8 p, uint8 *lo_out, uint8 *hi_out)
 {
-    uint rlo = 0u, rhi = 0u;
+    uint8 rlo = 0u, rhi = 0u;
     #pragma unroll
-    for (uint x = 0u; x <= w; ++x) {  /* unrolled: w is a build constant */
-        uint r = permute_round(x, p, w) << (4u * (x & 7u));
-        rlo |= (x < 8u) ? r : 0u;
-        rhi |= (x < 8u) ? 0u : r;
+    for (uint x = 0u; x <= w; ++x) {  /* w and l are build constants: every loop unrolls */
+        uint8 r = permute_round_v8((uint8)x, p, w) << (4u * (x & 7u));
+        if (x < 8u) rlo |= r; else rhi |= r;
     }
-    uint sh = p % l, lo = 0u, hi = 0u;
+    uint8 sh = p % l, lo = 0u, hi = 0u;
     #pragma unroll
     for (uint i = 0u; i < l; ++i) {
-        uint y = field4(rlo, rhi, i);
+        uint8 y = (((i < 8u) ? rlo : rhi) >> (4u * (i & 7u))) & 15u;
         #pragma unroll
         for (uint st = 0u; st + l < w + 1u; ++st)
-            y = (y < l) ? y : field4(rlo, rhi, y);
+            y = (y < l) ? y : field4_v8(rlo, rhi, y);
         y += sh;
         y = (y >= l) ? y - l : y;
-        y = (p ? y : i) << (4u * (i & 7u));
-        lo |= (i < 8u) ? y : 0u;
-        hi |= (i < 8u) ? 0u : y;
+        y = ((p != 0u) ? y : (uint8)i) << (4u * (i & 7u));
+        if (i < 8u) lo |= y; else hi |= y;
     }
     *lo_out = lo;
     *hi_out = hi;
@@ -79,25 +77,36 @@ void permutation_fields(uint l, uint w, uint p, uint *lo_out, uint *hi_out)
  * stratum permutation as fields (VS_PACKED) or [0] its seed; [2, 3] the
  * sub-stratum permutation as fields (VSUB == 1) or [2] its seed; [4] the
  * jitter seed. The keys come from the pixel and dimension numbers here
- * (docs/spec.md sections 3 and 6), not from the host. One work-item per pd:
- * PoCL vectorizes across them. */
+ * (docs/spec.md sections 3 and 6), not from the host. Each work-item does 8
+ * consecutive pd as the lanes of 8-lane vectors (3.3x PoCL's own
+ * vectorization of one pd per work-item); the host pads `pixels` and `pk`
+ * so that the last work-item's extra lanes read and write in bounds. */
 __kernel void vector_tables(__global uint *restrict pk,
                             __global const uint *restrict pixels,
                             __global const uint *restrict dims,
                             const uint seed)
 {
-    uint pd = (uint)get_global_id(0);
-    uint j = dims[pd % VND];
-    uint q = block_seed(pixel_seed(seed, pixels[pd / VND]), j / VDMAX) * (j % VDMAX + 1u);
-    uint w0 = q * STRATUM_KEY, w1 = 0u, w2 = q * SUBSTRATUM_KEY, w3 = 0u;
+    uint g = (uint)get_global_id(0);
+    uint qs[8];
+    #pragma unroll
+    for (uint r = 0u; r < 8u; ++r) {
+        uint pd = 8u * g + r, j = dims[pd % VND];
+        qs[r] = block_seed(pixel_seed(seed, pixels[pd / VND]), j / VDMAX) * (j % VDMAX + 1u);
+    }
+    uint8 q = vload8(0, qs);
+    uint8 w0 = q * STRATUM_KEY, w1 = 0u, w2 = q * SUBSTRATUM_KEY, w3 = 0u, w4 = q * JITTER_KEY;
 #if VS_PACKED
-    permutation_fields(VS, VWS, q * STRATUM_KEY, &w0, &w1);
+    permutation_fields_v8(VS, VWS, q * STRATUM_KEY, &w0, &w1);
 #endif
 #if VSUB == 1
-    permutation_fields(VM, VWM, q * SUBSTRATUM_KEY, &w2, &w3);
+    permutation_fields_v8(VM, VWM, q * SUBSTRATUM_KEY, &w2, &w3);
 #endif
-    __global uint *o = pk + 8u * pd;
-    o[0] = w0; o[1] = w1; o[2] = w2; o[3] = w3; o[4] = q * JITTER_KEY;
+    __global uint *o = pk + 64u * g;
+    #pragma unroll
+    for (uint r = 0u; r < 8u; ++r) {
+        o[8u * r + 0u] = w0[r]; o[8u * r + 1u] = w1[r]; o[8u * r + 2u] = w2[r];
+        o[8u * r + 3u] = w3[r]; o[8u * r + 4u] = w4[r];
+    }
 }
 
 /* Values of sample positions [8 b, 8 b + 8) of pixel pl (axis 0: b, axis 1:
@@ -120,7 +129,7 @@ __kernel void vector_values(__global float *restrict out,
         __global const uint *w = pk + 8u * (pl * VND + d);
         uint8 aij = vload8(b, cell_a + d * VNKP);
 #if VS_PACKED
-        uint8 stratum = field4_v8(w[0], w[1], aij);
+        uint8 stratum = field4_v8((uint8)w[0], (uint8)w[1], aij);
 #else
         uint8 stratum = permute_bounded_v8(aij, (uint8)w[0], VS, VWS, VS_ROUNDS);
 #endif
@@ -130,7 +139,7 @@ __kernel void vector_values(__global float *restrict out,
 #else
         uint8 u = vload8(b, cell_u + d * VNKP);
 #if VSUB == 1
-        uint8 sub = field4_v8(w[2], w[3], u);
+        uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
 #else
 #if VOFFSET == OFFSET_J
 #if VJKEY_BOSE
@@ -157,3 +166,4 @@ __kernel void vector_values(__global float *restrict out,
 #endif
     VSTORE_BLOCK
 }
+

@@ -222,7 +222,7 @@ class OpenCLBackend:
         if main < n:
             kernel(self.queue, (n - main,), (n - main,), *args, global_offset=(main,))
 
-    def _launch_vector(self, req: Request, rect: Rect, shp: "vector.Shape", buf, at: int) -> None:
+    def _launch_vector(self, req: Request, rect: Rect, shp: vector.Shape, buf, at: int) -> None:
         """The vector path over one rectangle of whole pixels: ``vector_tables``
         then ``vector_values`` (kernels/vector.cl), writing values ``[at, at +
         rect values)`` of ``buf``. Called with self._lock held."""
@@ -231,10 +231,14 @@ class OpenCLBackend:
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         k_tables, k_values = vector.kernels(self.context, self.info, shp)
         n_pd = rect.n_pixels * req.n_dims
-        pk = self._scratch("vector", n_pd * vector.TABLE_WORDS * 4)
-        pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[rect.pix0 : rect.pix1]))
+        groups = -(-n_pd // vector.LANES)  # vector_tables does 8 (pixel, dimension) pairs per work-item
+        pk = self._scratch("vector", groups * vector.LANES * vector.TABLE_WORDS * 4)
+        # padded so that the last work-item's extra lanes read a pixel (and write padding)
+        pixels = np.zeros(-(-groups * vector.LANES // req.n_dims), np.uint32)
+        pixels[: rect.n_pixels] = req.pixels[rect.pix0 : rect.pix1]
+        pixels = cl.Buffer(self.context, ro, hostbuf=pixels)
         dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
-        self._launch_1d(k_tables, n_pd, pk, pixels, dims, np.uint32(req.seed))
+        self._launch_1d(k_tables, groups, pk, pixels, dims, np.uint32(req.seed))
         aij, u, samples = (cl.Buffer(self.context, ro, hostbuf=a) for a in vector.cell_arrays(req, shp))
         self._launch_2d_kernel(k_values, shp.n_blocks, rect.n_pixels,
                                buf, np.uint32(at), pk, aij, u, samples, np.float32(req.jitter))
