@@ -10,4 +10,4 @@
 SOURCES = ("hashes.cl", "floats.cl", "gf.cl", "oa.cl", "baselines.cl", "generate.cl")
 #: The vector path's program (pyoa._opencl.vector): built per request shape,
 #: with that shape's constants as defines.
-VECTOR_SOURCES = ("hashes.cl", "floats.cl", "vector.cl")
+VECTOR_SOURCES = ("hashes.cl", "floats.cl", "baselines.cl", "vector.cl")

@@ -42,6 +42,8 @@ uint8 permute_bounded_v8(uint8 i, uint8 p, uint l, uint w, uint rounds)
     return (p != 0u) ? x : i;
 }
 
+#ifndef VBASELINE  /* the orthogonal arrays' kernels */
+
 /* Entries a (< 16) of permutations stored as 4-bit fields: 0..7 in lo, 8..15 in hi. */
 uint8 field4_v8(uint8 lo, uint8 hi, uint8 a) { return (((a < 8u) ? lo : hi) >> ((a & 7u) * 4u)) & 15u; }
 
@@ -167,3 +169,55 @@ __kernel void vector_values(__global float *restrict out,
     VSTORE_BLOCK
 }
 
+#endif  /* VBASELINE */
+
+#ifdef VBASELINE
+/* The padded 2D comparison samplers (baselines.cl), VBASELINE 1 =
+ * jittered2d (grid VBA x VBA; VBB is the request's dims, for the lone last
+ * dimension), 2 = cmj2d (grid VBA x VBB). Each permute of baselines.cl is a
+ * bounded walk here (VBN_ROUNDS for the sample order on [0, VBN), VBA_ROUNDS
+ * and VBB_ROUNDS for the sub-strata); the rest as in vector_values. */
+__kernel void vector_baseline(__global float *restrict out,
+                              const uint out0,
+                              __global const uint *restrict pixels,
+                              __global const uint *restrict dims,
+                              __global const uint *restrict isamp,
+                              const uint seed,
+                              const float J)
+{
+    uint b = (uint)get_global_id(0), pl = (uint)get_global_id(1);
+    uint8 i = vload8(b, isamp);
+    uint p = pixel_seed(seed, pixels[pl]);
+    float8 V[VND];
+    #pragma unroll
+    for (uint d = 0u; d < VND; ++d) {
+        uint j = dims[d];
+        uint q = derived_seed(p, j >> 1, PAD_KEY);
+        uint8 k = permute_bounded_v8(i, (uint8)(q * SHUFFLE_KEY), VBN, walk_mask(VBN), VBN_ROUNDS);
+        bool even = (j & 1u) == 0u;
+#if VBASELINE == 1
+        float8 jit = jitter_value_v8(randfloat_v8(k, q * (even ? JITX_KEY : JITY_KEY)), J);
+        if (even && j + 1u == VBB)  /* a lone last dimension */
+            V[d] = sample_value_v8(k, (uint8)0u, jit, 1u, VBN);
+        else
+            V[d] = sample_value_v8(even ? k % VBA : k / VBA, (uint8)0u, jit, 1u, VBA);
+#else
+        if (even) {
+            uint8 sy = permute_bounded_v8(k / VBA, (uint8)(q * SUBY_KEY), VBB, walk_mask(VBB), VBB_ROUNDS);
+            V[d] = sample_value_v8(k % VBA, sy, jitter_value_v8(randfloat_v8(k, q * JITX_KEY), J), VBB, VBA);
+        } else {
+            uint8 sx = permute_bounded_v8(k % VBA, (uint8)(q * SUBX_KEY), VBA, walk_mask(VBA), VBA_ROUNDS);
+            V[d] = sample_value_v8(k / VBA, sx, jitter_value_v8(randfloat_v8(k, q * JITY_KEY), J), VBA, VBB);
+        }
+#endif
+    }
+    __global float *o = out + out0 + (pl * VNK + 8u * b) * VND;
+#if VNK % 8
+    if (b + 1u == VNKP / 8u) {
+        VSTORE_TAIL
+        return;
+    }
+#endif
+    VSTORE_BLOCK
+}
+#endif  /* VBASELINE */

@@ -190,7 +190,12 @@ class OpenCLBackend:
             for rect in req.rectangles(row0, row1):
                 # each rectangle's values are a contiguous part of the chunk
                 at = np.uint32((rect.row0 - row0) * req.n_dims)
-                if req.construction.family != "baseline":
+                if req.construction.family == "baseline":
+                    bshp = vector.baseline_shape(req, rect) if self.path == "vector" else None
+                    if bshp is not None:
+                        self._launch_vector_baseline(req, rect, bshp, buf, at)
+                        continue
+                else:
                     shp = vector.shape(req, rect) if self.path == "vector" else None
                     if shp is not None:
                         self._launch_vector(req, rect, shp, buf, at)
@@ -242,6 +247,19 @@ class OpenCLBackend:
         aij, u, samples = (cl.Buffer(self.context, ro, hostbuf=a) for a in vector.cell_arrays(req, shp))
         self._launch_2d_kernel(k_values, shp.n_blocks, rect.n_pixels,
                                buf, np.uint32(at), pk, aij, u, samples, np.float32(req.jitter))
+
+    def _launch_vector_baseline(self, req: Request, rect: Rect, shp: vector.BaselineShape, buf, at: int) -> None:
+        """``vector_baseline`` (kernels/vector.cl) over one rectangle of whole
+        pixels of a padded 2D comparison sampler. Called with self._lock held."""
+        import pyopencl as cl
+
+        ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
+        (kernel,) = vector.kernels(self.context, self.info, shp)
+        pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[rect.pix0 : rect.pix1]))
+        dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
+        samples = cl.Buffer(self.context, ro, hostbuf=np.pad(req.samples, (0, shp.n_k_padded - shp.n_k)))
+        self._launch_2d_kernel(kernel, shp.n_blocks, rect.n_pixels, buf, np.uint32(at), pixels, dims, samples,
+                               np.uint32(req.seed), np.float32(req.jitter))
 
     def _launch_tabled(self, req: Request, rect: Rect, buf, at: int) -> None:
         """The table path over one rectangle: ``tables`` then ``generate_cells``,

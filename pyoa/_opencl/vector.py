@@ -95,6 +95,57 @@ class Shape:
         return "".join(f"#define {name} {value}\n" for name, value in consts.items())
 
 
+@dataclass(frozen=True)
+class BaselineShape:
+    """The build constants of one vector program of a padded 2D comparison
+    sampler (``jittered2d``: kind 1, grid a x a, b = the sampler's dims;
+    ``cmj2d``: kind 2, grid a x b). See kernels/vector.cl, vector_baseline."""
+
+    kind: int
+    a: int
+    b: int
+    n_dims: int
+    n_k: int
+
+    #: Comparison samplers with a vector kernel, and their kind.
+    KINDS = {"jittered2d": 1, "cmj2d": 2}
+
+    @property
+    def N(self) -> int:
+        return self.a * (self.a if self.kind == 1 else self.b)
+
+    @property
+    def n_blocks(self) -> int:
+        return -(-self.n_k // LANES)
+
+    @property
+    def n_k_padded(self) -> int:
+        return self.n_blocks * LANES
+
+    def header(self) -> str:
+        block, tail = store_code(self.n_dims, self.n_k % LANES)
+        consts = {
+            "VBASELINE": self.kind, "VBA": f"{self.a}u", "VBB": f"{self.b}u", "VBN": f"{self.N}u",
+            "VBN_ROUNDS": f"{walk_rounds(self.N)}u", "VBA_ROUNDS": f"{walk_rounds(self.a)}u",
+            "VBB_ROUNDS": f"{walk_rounds(self.b) if self.kind == 2 else 0}u",
+            "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
+            "VSTORE_BLOCK": block, "VSTORE_TAIL": tail,
+        }
+        return "".join(f"#define {name} {value}\n" for name, value in consts.items())
+
+
+def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:
+    """The vector program of a ``jittered2d`` or ``cmj2d`` rectangle, or None
+    (other samplers, and the limits of :func:`shape`)."""
+    kind = BaselineShape.KINDS.get(req.construction.name)
+    if kind is None or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_DIMS:
+        return None
+    a, b = req.construction.shape_args(req.params)
+    shp = BaselineShape(kind, a, b, req.n_dims, rect.n_k)
+    walks = [shp.N, a] + ([b] if kind == 2 else [])
+    return shp if max(walk_rounds(n) for n in walks) <= MAX_ROUNDS else None
+
+
 def shape(req: Request, rect: Rect) -> Shape | None:
     """The vector program for rectangle ``rect`` of ``req``, or None when the
     rectangle does not take the vector path (module docstring)."""
@@ -143,9 +194,9 @@ _lock = threading.Lock()
 _programs: dict[tuple, tuple] = {}
 
 
-def kernels(context, info, shp: Shape) -> tuple:
+def kernels(context, info, shp: Shape | BaselineShape) -> tuple:
     """``(vector_tables, vector_values)`` built for ``shp`` in ``context``,
-    once per process.
+    once per process; ``(vector_baseline,)`` for a :class:`BaselineShape`.
 
     Raises
     ------
@@ -168,7 +219,8 @@ def kernels(context, info, shp: Shape) -> tuple:
             except cl.Error as exc:
                 noise = "".join(printed)
                 raise program.BuildError(info, "build", str(exc) + (f"\n{noise}" if noise.strip() else "")) from exc
-            _programs[key] = (cl.Kernel(prg, "vector_tables"), cl.Kernel(prg, "vector_values"))
+            names = ("vector_baseline",) if isinstance(shp, BaselineShape) else ("vector_tables", "vector_values")
+            _programs[key] = tuple(cl.Kernel(prg, name) for name in names)
         return _programs[key]
 
 
