@@ -31,7 +31,7 @@
  * most MAX_ROUNDS of pyoa/_opencl/vector.py). Lanes that are done keep
  * their value. Then the final shift of permute (hashes.cl). Lanes with p == 0
  * are the identity. */
-uint8 permute_bounded_v8(uint8 i, uint8 p, uint l, uint w, uint rounds)
+static inline __attribute__((always_inline)) uint8 permute_bounded_v8(uint8 i, uint8 p, uint l, uint w, uint rounds)
 {
     uint8 x = permute_round_v8(i, p, w);
     #pragma unroll
@@ -51,7 +51,7 @@ uint8 field4_v8(uint8 lo, uint8 hi, uint8 a) { return (((a < 8u) ? lo : hi) >> (
  * as 4-bit fields: permute_round of every x in [0, w] once, then each
  * entry's bounded walk through that table (at most w + 1 - l steps, see
  * permute_bounded_v8), then the final shift. */
-void permutation_fields_v8(uint l, uint w, uint8 p, uint8 *lo_out, uint8 *hi_out)
+static inline __attribute__((always_inline)) void permutation_fields_v8(uint l, uint w, uint8 p, uint8 *lo_out, uint8 *hi_out)
 {
     uint8 rlo = 0u, rhi = 0u;
     #pragma unroll

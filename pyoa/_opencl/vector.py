@@ -95,6 +95,10 @@ class Shape:
         return "".join(f"#define {name} {value}\n" for name, value in consts.items())
 
 
+#: Comparison samplers with a vector kernel, and their kind (VBASELINE).
+BASELINE_KINDS = {"jittered2d": 1, "cmj2d": 2}
+
+
 @dataclass(frozen=True)
 class BaselineShape:
     """The build constants of one vector program of a padded 2D comparison
@@ -106,9 +110,6 @@ class BaselineShape:
     b: int
     n_dims: int
     n_k: int
-
-    #: Comparison samplers with a vector kernel, and their kind.
-    KINDS = {"jittered2d": 1, "cmj2d": 2}
 
     @property
     def N(self) -> int:
@@ -137,7 +138,7 @@ class BaselineShape:
 def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:
     """The vector program of a ``jittered2d`` or ``cmj2d`` rectangle, or None
     (other samplers, and the limits of :func:`shape`)."""
-    kind = BaselineShape.KINDS.get(req.construction.name)
+    kind = BASELINE_KINDS.get(req.construction.name)
     if kind is None or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_DIMS:
         return None
     a, b = req.construction.shape_args(req.params)
