@@ -394,3 +394,53 @@ def test_path_from_environment_and_auto(monkeypatch, opencl, opencl_device):
     assert OpenCLBackend(opencl_device).path == auto
     if opencl.info.kind == "cpu":
         assert auto == "vector"
+
+
+# ----------------------------------------------------------------------------- 5. the padded 2D samplers
+
+#: (name, spp, sampler dims, requested dims): 11 x 11 and the non-square 10 x
+#: 12 grid; odd sampler dims give jittered2d its lone last dimension (N cells).
+BASELINE_CASES = [
+    ("jittered2d", 121, 10, None),
+    ("jittered2d", 121, 9, [8, 0, 1, 7, 3]),
+    ("cmj2d", 121, 10, None),
+    ("cmj2d", 120, 7, [6, 5, 0, 1, 2]),
+    ("jittered2d", 64, 16, None),
+]
+
+
+@pytest.mark.parametrize("jitter", JITTERS)
+@pytest.mark.parametrize("case", BASELINE_CASES, ids=lambda c: f"{c[0]}-{c[1]}x{c[2]}")
+@pytest.mark.parametrize("path", ["vector", "direct"])
+def test_padded_2d_paths_match_numpy(monkeypatch, backends, path, case, jitter):
+    """jittered2d and cmj2d: the vector kernel (vector_baseline) and the
+    generic one give NumPy's bits, at pixels up to 2**32 - 1 and the largest seed."""
+    from pyoa._opencl import vector
+
+    name, spp, dims, req_dims = case
+    be = backends[path]
+    smp = make(name, spp, dims, seed=U32_MAX, backend="numpy", jitter=jitter)
+    req = smp._request(CASE_PIXELS, None, req_dims)
+    assert vector.baseline_shape(req, whole_rect(req)) is not None
+    calls = []
+    real = type(be)._launch_vector_baseline.__get__(be)
+    monkeypatch.setattr(be, "_launch_vector_baseline", lambda *a: (calls.append(a[1]), real(*a)))
+    compare(be, smp, CASE_PIXELS, None, req_dims, f"{name} {spp} dims {req_dims} on {path}")
+    assert calls == (req.rectangles(0, req.n_rows) if path == "vector" else [])
+
+
+def test_padded_2d_vector_shape_limits():
+    """baseline_shape refuses fewer than 8 samples, more than MAX_DIMS
+    dimensions and walks over MAX_ROUNDS (17 x 17 = 289 in [0, 511])."""
+    from pyoa._opencl import vector
+
+    def shp(name, spp, dims, samples=None):
+        req = make(name, spp, dims, backend="numpy")._request([0, 1], samples, None)
+        return vector.baseline_shape(req, req.rectangles(0, req.n_rows)[0])
+
+    got = shp("cmj2d", 120, 4)
+    assert (got.kind, got.a, got.b, got.N) == (2, 10, 12, 120)
+    assert shp("jittered2d", 121, 3).N == 121
+    assert shp("cmj2d", 121, 4, samples=list(range(7))) is None
+    assert shp("cmj2d", 121, vector.MAX_DIMS + 1) is None
+    assert vector.walk_rounds(289) > vector.MAX_ROUNDS and shp("jittered2d", 289, 4) is None
