@@ -28,11 +28,17 @@ MAX_AXIS_GROUP = 1024
 #: ``tables`` (the table path of kernels/generate.cl where it pays off, else
 #: ``direct``) or ``direct`` (one work-item per value, everything from
 #: scratch). ``auto`` picks per device: ``vector`` on a CPU (PoCL: 2-3x the
-#: table path, docs/performance.md), ``direct`` on a GPU (the H100 ran it at
+#: table path, docs/performance.md) for requests of at least
+#: :data:`VECTOR_MIN_VALUES` values, ``direct`` on a GPU (the H100 ran it at
 #: 2.4-2.7 G values/s against 1.9 for the table path).
 PATHS = ("auto", "vector", "tables", "direct")
 #: Environment variable overriding the ``auto`` choice (one of :data:`PATHS`).
 ENV_PATH = "PYOA_OPENCL_PATH"
+#: Smallest request (pixels x samples x dims) for which ``auto`` builds a
+#: vector program: a new shape costs about a second to build once per process
+#: (docs/performance.md, "First use of a shape"); below 2^20 values the
+#: vector path saves under 2 ms a call.
+VECTOR_MIN_VALUES = 1 << 20
 
 
 class OpenCLBackend:
@@ -76,6 +82,9 @@ class OpenCLBackend:
         self.zero_copy = self.info.kind == "cpu"
         #: The orthogonal arrays' path on this device (see :data:`PATHS`).
         self.path = path if path != "auto" else "vector" if self.info.kind == "cpu" else "direct"
+        #: Whether the path was asked for (then the vector path takes requests
+        #: of any size) rather than chosen by ``auto``.
+        self.path_forced = path != "auto"
         self._axis_limit = min(
             [MAX_AXIS_GROUP]
             + [self._kernels[k].get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.info.device)
@@ -187,16 +196,18 @@ class OpenCLBackend:
                          np.uint32(prm.s), np.uint32(prm.strength),
                          np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
                          *self._field(req.construction.field_order(prm)), self._constants(req))
+            use_vector = self.path == "vector" and (
+                self.path_forced or req.n_rows * req.n_dims >= VECTOR_MIN_VALUES)
             for rect in req.rectangles(row0, row1):
                 # each rectangle's values are a contiguous part of the chunk
                 at = np.uint32((rect.row0 - row0) * req.n_dims)
                 if req.construction.family == "baseline":
-                    bshp = vector.baseline_shape(req, rect) if self.path == "vector" else None
+                    bshp = vector.baseline_shape(req, rect) if use_vector else None
                     if bshp is not None:
                         self._launch_vector_baseline(req, rect, bshp, buf, at)
                         continue
                 else:
-                    shp = vector.shape(req, rect) if self.path == "vector" else None
+                    shp = vector.shape(req, rect) if use_vector else None
                     if shp is not None:
                         self._launch_vector(req, rect, shp, buf, at)
                         continue

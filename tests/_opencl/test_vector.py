@@ -444,3 +444,27 @@ def test_padded_2d_vector_shape_limits():
     assert shp("cmj2d", 121, 4, samples=list(range(7))) is None
     assert shp("cmj2d", 121, vector.MAX_DIMS + 1) is None
     assert vector.walk_rounds(289) > vector.MAX_ROUNDS and shp("jittered2d", 289, 4) is None
+
+
+def test_auto_takes_the_vector_path_only_for_large_requests(monkeypatch, opencl, opencl_device):
+    """``auto`` on a CPU builds a vector program only for requests of at least
+    VECTOR_MIN_VALUES values (a build costs about a second once); a forced
+    ``vector`` takes any size. Both give NumPy's bits."""
+    from pyoa._opencl import backend as backend_mod
+    from pyoa._opencl.backend import OpenCLBackend
+
+    if opencl.info.kind != "cpu":
+        pytest.skip("auto picks the direct path on this device")
+    monkeypatch.delenv(backend_mod.ENV_PATH, raising=False)
+    auto, forced = OpenCLBackend(opencl_device), OpenCLBackend(opencl_device, path="vector")
+    assert not auto.path_forced and forced.path_forced
+    smp = make("bose", 121, 10, seed=9, backend="numpy")
+    pixels = list(range(7))  # 8,470 values
+    for be, takes in ((auto, False), (forced, True)):
+        launched = spy(monkeypatch, be)
+        req = compare(be, smp, pixels, None, None, f"small request, path_forced={be.path_forced}")
+        assert bool(launched["vector"]) is takes
+    monkeypatch.setattr(backend_mod, "VECTOR_MIN_VALUES", len(pixels) * 121 * 10)
+    launched = spy(monkeypatch, auto)
+    req = compare(auto, smp, pixels, None, None, "request at the threshold")
+    assert launched["vector"] == req.rectangles(0, req.n_rows)
