@@ -208,6 +208,8 @@ class OpenCLBackend:
                         continue
                 else:
                     shp = vector.shape(req, rect) if use_vector else None
+                    if shp is not None and not self.path_forced and not shp.tabled and req.tables_pay_off(rect):
+                        shp = None  # a walked permutation: the table path is faster ('cmj', 'centered')
                     if shp is not None:
                         self._launch_vector(req, rect, shp, buf, at)
                         continue

@@ -80,6 +80,17 @@ class Shape:
     def n_k_padded(self) -> int:
         return self.n_blocks * LANES
 
+    @property
+    def tabled(self) -> bool:
+        """Whether no value walks a permutation (both are 4-bit fields).
+
+        For 'cmj' and 'centered' a walked permutation is slower than the
+        table path of kernels/generate.cl, which tables it whatever its size
+        (Bush s = 5 t = 3 'cmj', M = 25: 277 against about 460 M values/s,
+        docs/performance.md), so ``auto`` takes the vector path for them only
+        when this holds."""
+        return self.s_packed and self.sub != 2
+
     def header(self) -> str:
         """The ``#define`` lines that open the program text (the generated
         stores do not fit ``-D`` options, which the driver splits at spaces)."""

@@ -468,3 +468,24 @@ def test_auto_takes_the_vector_path_only_for_large_requests(monkeypatch, opencl,
     launched = spy(monkeypatch, auto)
     req = compare(auto, smp, pixels, None, None, "request at the threshold")
     assert launched["vector"] == req.rectangles(0, req.n_rows)
+
+
+def test_auto_prefers_the_table_path_over_walked_cmj(monkeypatch, opencl, opencl_device):
+    """``auto``: 'cmj' with a walked permutation (Bush s = 5 t = 3, M = 25)
+    takes the table path, which tables it; Bose s = 11 (both permutations as
+    fields) takes the vector path; 'mj' always the vector path."""
+    from pyoa._opencl import backend as backend_mod
+    from pyoa._opencl.backend import OpenCLBackend
+
+    if opencl.info.kind != "cpu":
+        pytest.skip("auto picks the direct path on this device")
+    monkeypatch.delenv(backend_mod.ENV_PATH, raising=False)
+    monkeypatch.setattr(backend_mod, "VECTOR_MIN_VALUES", 0)
+    be = OpenCLBackend(opencl_device)
+    for kw, offset, where in [({"name": "bush", "spp": 125, "strength": 3}, "cmj", "tables"),
+                              ({"name": "bush", "spp": 125, "strength": 3}, "mj", "vector"),
+                              ({"name": "bose", "spp": 121}, "cmj", "vector")]:
+        smp = make(**kw, dims=6, seed=2, offset=offset, backend="numpy")
+        launched = spy(monkeypatch, be)
+        req = compare(be, smp, [0, 3, U32_MAX], None, None, f"auto {kw} {offset}")
+        assert launched[where] == req.rectangles(0, req.n_rows), (kw, offset, launched)
