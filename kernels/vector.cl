@@ -25,6 +25,18 @@
  * two 32-bit words, read with a variable shift instead of two gathers; the
  * walk of Kensler's permute is bounded (below), so no loop is left. */
 
+/* Stores V[d] (lane r: sample position 8 b + r of dimension d) as output
+ * rows of pixel pl: out + out0 + (pl * VNK + 8 b + r) * VND + d. The last
+ * block of a pixel whose VNK is not a multiple of 8 stores only its valid
+ * rows (VSTORE_TAIL, one value at a time); the condition is constant-folded
+ * away when there is no tail. */
+#define STORE_ROWS(V, b, pl)                                                            \
+    do {                                                                                \
+        __global float *o = out + out0 + ((pl) * VNK + 8u * (b)) * VND;                 \
+        if ((VNK % 8u) != 0u && (b) + 1u == VNKP / 8u) { VSTORE_TAIL }                  \
+        else { VSTORE_BLOCK }                                                           \
+    } while (0)
+
 /* A bounded walk: the cycle of permute_round through i < l reaches a value
  * below l after at most (w + 1 - l) values at or above l, so w + 2 - l
  * rounds always end it (and the host only builds this path when that is at
@@ -159,14 +171,7 @@ __kernel void vector_values(__global float *restrict out,
         V[d] = sample_value_v8(stratum, sub, jit, VM, VS);
 #endif
     }
-    __global float *o = out + out0 + (pl * VNK + 8u * b) * VND;
-#if VNK % 8
-    if (b + 1u == VNKP / 8u) {
-        VSTORE_TAIL
-        return;
-    }
-#endif
-    VSTORE_BLOCK
+    STORE_ROWS(V, b, pl);
 }
 
 #endif  /* VBASELINE */
@@ -211,13 +216,6 @@ __kernel void vector_baseline(__global float *restrict out,
         }
 #endif
     }
-    __global float *o = out + out0 + (pl * VNK + 8u * b) * VND;
-#if VNK % 8
-    if (b + 1u == VNKP / 8u) {
-        VSTORE_TAIL
-        return;
-    }
-#endif
-    VSTORE_BLOCK
+    STORE_ROWS(V, b, pl);
 }
 #endif  /* VBASELINE */

@@ -204,14 +204,14 @@ class OpenCLBackend:
                 if req.construction.family == "baseline":
                     bshp = vector.baseline_shape(req, rect) if use_vector else None
                     if bshp is not None:
-                        self._launch_vector_baseline(req, rect, bshp, buf, at)
+                        self._launch_vector_baseline(req, rect, bshp, buf, at, dims)
                         continue
                 else:
                     shp = vector.shape(req, rect) if use_vector else None
                     if shp is not None and not self.path_forced and not shp.tabled and req.tables_pay_off(rect):
                         shp = None  # a walked permutation: the table path is faster ('cmj', 'centered')
                     if shp is not None:
-                        self._launch_vector(req, rect, shp, buf, at)
+                        self._launch_vector(req, rect, shp, buf, at, dims)
                         continue
                     if self.path != "direct" and req.tables_pay_off(rect):
                         self._launch_tabled(req, rect, buf, at)
@@ -240,7 +240,7 @@ class OpenCLBackend:
         if main < n:
             kernel(self.queue, (n - main,), (n - main,), *args, global_offset=(main,))
 
-    def _launch_vector(self, req: Request, rect: Rect, shp: vector.Shape, buf, at: int) -> None:
+    def _launch_vector(self, req: Request, rect: Rect, shp: vector.Shape, buf, at: int, dims) -> None:
         """The vector path over one rectangle of whole pixels: ``vector_tables``
         then ``vector_values`` (kernels/vector.cl), writing values ``[at, at +
         rect values)`` of ``buf``. Called with self._lock held."""
@@ -255,13 +255,13 @@ class OpenCLBackend:
         pixels = np.zeros(-(-groups * vector.LANES // req.n_dims), np.uint32)
         pixels[: rect.n_pixels] = req.pixels[rect.pix0 : rect.pix1]
         pixels = cl.Buffer(self.context, ro, hostbuf=pixels)
-        dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
         self._launch_1d(k_tables, groups, pk, pixels, dims, np.uint32(req.seed))
         aij, u, samples = (cl.Buffer(self.context, ro, hostbuf=a) for a in vector.cell_arrays(req, shp))
         self._launch_2d_kernel(k_values, shp.n_blocks, rect.n_pixels,
                                buf, np.uint32(at), pk, aij, u, samples, np.float32(req.jitter))
 
-    def _launch_vector_baseline(self, req: Request, rect: Rect, shp: vector.BaselineShape, buf, at: int) -> None:
+    def _launch_vector_baseline(self, req: Request, rect: Rect, shp: vector.BaselineShape, buf, at: int,
+                                dims) -> None:
         """``vector_baseline`` (kernels/vector.cl) over one rectangle of whole
         pixels of a padded 2D comparison sampler. Called with self._lock held."""
         import pyopencl as cl
@@ -269,7 +269,6 @@ class OpenCLBackend:
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         (kernel,) = vector.kernels(self.context, self.info, shp)
         pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[rect.pix0 : rect.pix1]))
-        dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
         samples = cl.Buffer(self.context, ro, hostbuf=np.pad(req.samples, (0, shp.n_k_padded - shp.n_k)))
         self._launch_2d_kernel(kernel, shp.n_blocks, rect.n_pixels, buf, np.uint32(at), pixels, dims, samples,
                                np.uint32(req.seed), np.float32(req.jitter))

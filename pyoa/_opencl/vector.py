@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import constructions
+from ..reference.hashes import walk_mask
 from ..request import Rect, Request
 
 #: Lanes per vector: 8 (AVX2's width; on AVX-512, 16 lanes measured slower).
@@ -48,18 +49,38 @@ MAX_ROUNDS = 16
 TABLE_WORDS = 8
 
 
-def walk_mask(n: int) -> int:
-    """The all-ones mask just covering ``n - 1`` (``walk_mask`` of hashes.cl)."""
-    return (1 << (n - 1).bit_length()) - 1
-
-
 def walk_rounds(n: int) -> int:
     """Rounds that always end a walk of Kensler's permute on ``[0, n)``."""
     return walk_mask(n) + 2 - n
 
 
+class _Rows:
+    """What every vector program shares: ``n_dims`` dimensions and ``n_k``
+    sample positions per pixel, computed in blocks of :data:`LANES`."""
+
+    n_dims: int
+    n_k: int
+
+    @property
+    def n_blocks(self) -> int:
+        return -(-self.n_k // LANES)
+
+    @property
+    def n_k_padded(self) -> int:
+        return self.n_blocks * LANES
+
+    def _header(self, consts: dict) -> str:
+        """``#define`` lines of ``consts`` and the row constants. The
+        generated stores do not fit ``-D`` options, which the driver splits
+        at spaces, so the constants open the program text instead."""
+        block, tail = store_code(self.n_dims, self.n_k % LANES)
+        consts = {**consts, "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
+                  "VSTORE_BLOCK": block, "VSTORE_TAIL": tail}
+        return "".join(f"#define {name} {value}\n" for name, value in consts.items())
+
+
 @dataclass(frozen=True)
-class Shape:
+class Shape(_Rows):
     """The build constants of one vector program (see kernels/vector.cl)."""
 
     s: int
@@ -73,14 +94,6 @@ class Shape:
     jkey_bose: bool
 
     @property
-    def n_blocks(self) -> int:
-        return -(-self.n_k // LANES)
-
-    @property
-    def n_k_padded(self) -> int:
-        return self.n_blocks * LANES
-
-    @property
     def tabled(self) -> bool:
         """Whether no value walks a permutation (both are 4-bit fields).
 
@@ -92,18 +105,13 @@ class Shape:
         return self.s_packed and self.sub != 2
 
     def header(self) -> str:
-        """The ``#define`` lines that open the program text (the generated
-        stores do not fit ``-D`` options, which the driver splits at spaces)."""
-        block, tail = store_code(self.n_dims, self.n_k % LANES)
-        consts = {
+        """The ``#define`` lines that open the program text."""
+        return self._header({
             "VS": f"{self.s}u", "VM": f"{self.M}u", "VWS": f"{walk_mask(self.s)}u", "VWM": f"{walk_mask(self.M)}u",
-            "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
             "VDMAX": f"{self.block_dims}u", "VOFFSET": constructions.OFFSET_CODES[self.offset],
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
-            "VSTORE_BLOCK": block, "VSTORE_TAIL": tail,
-        }
-        return "".join(f"#define {name} {value}\n" for name, value in consts.items())
+        })
 
 
 #: Comparison samplers with a vector kernel, and their kind (VBASELINE).
@@ -111,7 +119,7 @@ BASELINE_KINDS = {"jittered2d": 1, "cmj2d": 2}
 
 
 @dataclass(frozen=True)
-class BaselineShape:
+class BaselineShape(_Rows):
     """The build constants of one vector program of a padded 2D comparison
     sampler (``jittered2d``: kind 1, grid a x a, b = the sampler's dims;
     ``cmj2d``: kind 2, grid a x b). See kernels/vector.cl, vector_baseline."""
@@ -126,24 +134,13 @@ class BaselineShape:
     def N(self) -> int:
         return self.a * (self.a if self.kind == 1 else self.b)
 
-    @property
-    def n_blocks(self) -> int:
-        return -(-self.n_k // LANES)
-
-    @property
-    def n_k_padded(self) -> int:
-        return self.n_blocks * LANES
-
     def header(self) -> str:
-        block, tail = store_code(self.n_dims, self.n_k % LANES)
-        consts = {
+        """The ``#define`` lines that open the program text."""
+        return self._header({
             "VBASELINE": self.kind, "VBA": f"{self.a}u", "VBB": f"{self.b}u", "VBN": f"{self.N}u",
             "VBN_ROUNDS": f"{walk_rounds(self.N)}u", "VBA_ROUNDS": f"{walk_rounds(self.a)}u",
             "VBB_ROUNDS": f"{walk_rounds(self.b) if self.kind == 2 else 0}u",
-            "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
-            "VSTORE_BLOCK": block, "VSTORE_TAIL": tail,
-        }
-        return "".join(f"#define {name} {value}\n" for name, value in consts.items())
+        })
 
 
 def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:

@@ -28,6 +28,42 @@ PIXEL_KEY = 0x5BD1E995
 BLOCK_KEY = 0x1B873593
 
 
+def walk_mask(l: int) -> int:
+    """The all-ones mask just covering ``l - 1``: the domain ``[0, w]`` of
+    :func:`permute`'s cycle walk."""
+    w = l - 1
+    w |= w >> 1
+    w |= w >> 2
+    w |= w >> 4
+    w |= w >> 8
+    w |= w >> 16
+    return w
+
+
+def permute_round(i: int, p: int, w: int) -> int:
+    """One round of Kensler's bijection on ``[0, w]`` with seed ``p``: the body
+    of :func:`permute`'s cycle walk (``permute_round`` of kernels/hashes.cl)."""
+    i ^= p
+    i = (i * 0xE170893D) & MASK
+    i ^= p >> 16
+    i ^= (i & w) >> 4
+    i ^= p >> 8
+    i = (i * 0x0929EB3F) & MASK
+    i ^= p >> 23
+    i ^= (i & w) >> 1
+    i = (i * (1 | (p >> 27))) & MASK
+    i = (i * 0x6935FA69) & MASK
+    i ^= (i & w) >> 11
+    i = (i * 0x74DCB303) & MASK
+    i ^= (i & w) >> 2
+    i = (i * 0x9E501CC3) & MASK
+    i ^= (i & w) >> 2
+    i = (i * 0xC860A3DF) & MASK
+    i &= w
+    i ^= i >> 5
+    return i
+
+
 def permute(i: int, l: int, p: int) -> int:
     """Element ``i`` of the ``p``-th pseudo-random permutation of ``0..l-1``.
 
@@ -52,31 +88,9 @@ def permute(i: int, l: int, p: int) -> int:
         raise ValueError(f"permute needs 1 <= l <= 2**31 and 0 <= i < l, got i={i}, l={l}")
     if p == 0:
         return i
-    w = l - 1
-    w |= w >> 1
-    w |= w >> 2
-    w |= w >> 4
-    w |= w >> 8
-    w |= w >> 16
+    w = walk_mask(l)
     while True:
-        i ^= p
-        i = (i * 0xE170893D) & MASK
-        i ^= p >> 16
-        i ^= (i & w) >> 4
-        i ^= p >> 8
-        i = (i * 0x0929EB3F) & MASK
-        i ^= p >> 23
-        i ^= (i & w) >> 1
-        i = (i * (1 | (p >> 27))) & MASK
-        i = (i * 0x6935FA69) & MASK
-        i ^= (i & w) >> 11
-        i = (i * 0x74DCB303) & MASK
-        i ^= (i & w) >> 2
-        i = (i * 0x9E501CC3) & MASK
-        i ^= (i & w) >> 2
-        i = (i * 0xC860A3DF) & MASK
-        i &= w
-        i ^= i >> 5
+        i = permute_round(i, p, w)
         if i < l:
             break
     return (i + p % l) % l

@@ -223,34 +223,13 @@ def test_vector_path_round_limit():
         assert shape_of("bose", 37 * 37, 10, offset) is None  # s = 37: the stratum walk is too long
 
 
-def permute_round(x: int, p: int, w: int) -> int:
-    """One round of pyoa.reference.permute's cycle walk (the body of its loop)."""
-    m = ref.hashes.MASK
-    x ^= p
-    x = (x * 0xE170893D) & m
-    x ^= p >> 16
-    x ^= (x & w) >> 4
-    x ^= p >> 8
-    x = (x * 0x0929EB3F) & m
-    x ^= p >> 23
-    x ^= (x & w) >> 1
-    x = (x * (1 | (p >> 27))) & m
-    x = (x * 0x6935FA69) & m
-    x ^= (x & w) >> 11
-    x = (x * 0x74DCB303) & m
-    x ^= (x & w) >> 2
-    x = (x * 0x9E501CC3) & m
-    x ^= (x & w) >> 2
-    x = (x * 0xC860A3DF) & m
-    x &= w
-    x ^= x >> 5
-    return x
+permute_round = ref.hashes.permute_round  # one round of permute's cycle walk
 
 
 def test_walk_rounds_bounds_every_walk():
     """For every start below l, the cycle walk of permute's round function ends
     (falls below l) within walk_rounds(l) rounds; brute force over small l and
-    random seeds. The round function copied here is checked against
+    random seeds. The reference's round function is checked against
     pyoa.reference.permute itself (walk, then the final shift) and is a
     bijection of [0, w]."""
     from pyoa._numpy.hashes import _permute_round
