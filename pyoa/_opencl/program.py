@@ -21,8 +21,6 @@ import threading
 from importlib import resources
 
 from .. import constructions
-from ..reference import baselines as _ref_baselines
-from ..reference import hashes as _ref_hashes
 from .device import DeviceInfo
 
 BUILD_OPTIONS = ["-cl-fp32-correctly-rounded-divide-sqrt"]
@@ -31,16 +29,24 @@ _lock = threading.Lock()
 _cache: dict[tuple, tuple] = {}
 
 
-#: Modules whose ``*_KEY`` constants the kernels use under the same names:
-#: their only definition (kernels/hashes.cl and baselines.cl check, with
-#: ``#error``, that each one they use is defined).
-KEY_MODULES = (_ref_hashes, _ref_baselines)
+def key_modules() -> list:
+    """Every module of :mod:`pyoa.reference`: their ``*_KEY`` constants are
+    the kernels' under the same names, and their only definition (the ``.cl``
+    files check, with ``#error``, that each one they use is defined). A new
+    sampler's reference module is picked up without being listed anywhere."""
+    import importlib
+    import pkgutil
+
+    from .. import reference
+
+    return [importlib.import_module(f"{reference.__name__}.{m.name}")
+            for m in sorted(pkgutil.iter_modules(reference.__path__), key=lambda m: m.name)]
 
 
 def kernel_keys() -> dict[str, int]:
-    """``name -> value`` of every ``*_KEY`` uint32 constant of :data:`KEY_MODULES`."""
+    """``name -> value`` of every ``*_KEY`` uint32 constant of :func:`key_modules`."""
     keys: dict[str, int] = {}
-    for module in KEY_MODULES:
+    for module in key_modules():
         for name, value in vars(module).items():
             if name.endswith("_KEY") and name.isupper() and isinstance(value, int):
                 if not 0 <= value <= 0xFFFFFFFF:

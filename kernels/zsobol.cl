@@ -1,0 +1,1 @@
+/* zsobol: pbrt-v4's ZSobolSampler (filled in with the sampler). */
