@@ -11,7 +11,12 @@
  *   loop in a kernel keeps PoCL scalar). Table entry layout per (pixel,
  *   dimension), E entries: [0, s) stratum permutation, [s, s + M)
  *   sub-stratum permutation ('cmj' only), [E - 1] the jitter seed P3.
- * The comparison samplers have one kernel each (generate_<name>). */
+ * The comparison samplers have one kernel each (generate_<name>).
+ *
+ * Which construction or comparison sampler a kernel computes is not written
+ * here: pyoa._opencl.program.dispatch_source generates oa_dispatch (one case
+ * per orthogonal array of the catalogue) and the generate_<name> kernels
+ * (GENERATE_BASELINE below) from the catalogue, after this file. */
 
 /* Every kernel runs over a rectangle of the request (whole pixels, or a run
  * of samples of one pixel) as a 2D NDRange: axis 0 is the sample position k
@@ -40,8 +45,13 @@ uint rect_index(uint out0, uint k, uint pl, uint d, uint n_k, uint n_dims)
 #define RECT_PRELUDE                                                                    \
     uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                       \
     uint d = pd % n_dims, pl = pd / n_dims;                                             \
-    uint i = samples[k], j = dims[d];                                                   \
-    uint p = pixel_seed(seed, pixels[pl])
+    uint i = samples[k], j = dims[d], pixel = pixels[pl];                               \
+    uint p = pixel_seed(seed, pixel)
+
+/* The value of construction `construction` (its CONSTRUCTION_* code):
+ * generated from the catalogue (pyoa._opencl.program.dispatch_source). */
+float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint p, uint offset, float J,
+               __global const ushort *gf, uint gf_tabled, __global const uint *consts);
 
 /* The direct path: any offset, everything from scratch (permute's cycle walk
  * keeps this kernel scalar on PoCL). */
@@ -57,14 +67,8 @@ __kernel void generate(RECT_ARGS,
                        __global const uint *consts)
 {
     RECT_PRELUDE;
-    float x;
-    if (construction == CONSTRUCTION_BOSE)      x = bose(i, j, s, p, offset, J, gf, gf_tabled);
-    else if (construction == CONSTRUCTION_BUSH) x = bush(i, j, s, t, p, offset, J, gf, gf_tabled);
-    else if (construction == CONSTRUCTION_ADDELMAN_KEMPTHORNE)
-        x = addelman_kempthorne(i, j, s, p, offset, J, gf, gf_tabled, consts);
-    else if (construction == CONSTRUCTION_BOSE_BUSH) x = bose_bush(i, j, s, p, offset, J, gf, gf_tabled);
-    else                                        x = cmjnd(i, j, s, t, p, offset, J);
-    out[rect_index(out0, k, pl, d, n_k, n_dims)] = x;
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = oa_dispatch(construction, i, j, s, t, p, offset, J,
+                                                            gf, gf_tabled, consts);
 }
 
 /* The table path, in two launches over a rectangle of pixels x samples
@@ -180,23 +184,21 @@ GENERATE_CELLS(generate_cells, sample_value(stratum, tab[base + s + cell_u[c]], 
 GENERATE_CELLS(generate_cells_centered, centered_value(stratum, jit, M, s))
 
 /* The comparison samplers: one kernel each, one work-item per value, over a
- * rectangle like `generate`. a and b are the sampler's shape arguments (Baseline.shape_args), `table` its
- * constants (Halton's primes, Sobol's direction numbers). */
+ * rectangle like `generate`. a, b and c are the sampler's shape arguments
+ * (its catalogue entry's shape_args, zero-padded), `table` its constants
+ * (Halton's primes, Sobol's direction numbers, pmj02's point sets); `pixel`
+ * and `seed` are in scope for samplers that use the image position. The
+ * instances, one per comparison sampler of the catalogue, are generated
+ * (pyoa._opencl.program.dispatch_source). */
 #define GENERATE_BASELINE(NAME, EXPR)                                                   \
 __kernel void generate_##NAME(RECT_ARGS,                                                \
                               const uint seed,                                          \
                               const uint a,                                             \
                               const uint b,                                             \
+                              const uint c,                                             \
                               const float J,                                            \
                               __global const uint *table)                               \
 {                                                                                       \
     RECT_PRELUDE;                                                                       \
     out[rect_index(out0, k, pl, d, n_k, n_dims)] = EXPR;                                \
 }
-
-GENERATE_BASELINE(random, sample_random(i, j, p))
-GENERATE_BASELINE(jittered2d, sample_jittered2d(i, j, a, b, p, J))
-GENERATE_BASELINE(cmj2d, sample_cmj2d(i, j, a, b, p, J))
-GENERATE_BASELINE(sobol02, sample_sobol02(i, j, a, p, table))
-GENERATE_BASELINE(halton, sample_halton(i, j, p, table))
-GENERATE_BASELINE(sobol, sample_sobol(i, j, p, table))

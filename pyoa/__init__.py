@@ -14,7 +14,8 @@ same float32 bits.
 
 from . import reference
 from .backends import PyoaFallbackWarning, backends
-from .constructions import OFFSETS, SppChoice, valid_spp
+from .catalogue import valid_spp
+from .catalogue_types import OFFSETS, SppChoice
 from .samplers import Sampler, sampler, samplers
 
 __version__ = "0.1.0"

@@ -62,7 +62,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .constructions import nearest_spp
+from .catalogue import nearest_spp
 from .samplers import _int as _checked_int
 
 __all__ = [

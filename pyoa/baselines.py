@@ -18,7 +18,18 @@ import math
 from collections.abc import Sequence
 
 from . import sequences
-from .constructions import MAX_DIMS, MAX_SPP, Construction, Params, SppChoice, nearest
+from ._numpy import baselines as _numpy_baselines
+from .catalogue_types import (
+    MAX_DIMS,
+    MAX_SPP,
+    Claim,
+    Construction,
+    Params,
+    SppChoice,
+    nearest,
+    register,
+)
+from .reference import baselines as _reference_baselines
 
 
 class AllCounts(Sequence):
@@ -44,11 +55,10 @@ class AllCounts(Sequence):
 class Baseline(Construction):
     """Base class of the comparison samplers.
 
-    Their implementations live in ``pyoa.reference.baselines`` and
-    ``pyoa._numpy.baselines``, called as ``function(i, j, *shape_args(params),
-    p[, jitter])``, and in the kernels ``generate_{function}`` of
-    ``kernels/generate.cl``. They have no offset styles; only the samplers
-    with ``jittered = True`` take a jitter amount.
+    Their implementations are called as ``function(i, j, *shape_args(params),
+    *seed_args(...)[, jitter])``, in the kernels by one ``generate_{function}``
+    kernel each (generated from ``kernel``). They have no offset styles; only
+    the samplers with ``jittered = True`` take a jitter amount.
     """
 
     family = "baseline"
@@ -59,6 +69,10 @@ class Baseline(Construction):
     max_dims = MAX_DIMS
     #: sample counts: "any" (1 .. 2**24), "pow2" (powers of two) or "square"
     counts = "any"
+    #: largest sample count
+    max_spp = MAX_SPP
+    #: the vector kernel of kernels/vector.cl (VBASELINE) that computes it, or 0
+    vector_kind = 0
 
     def params(self, spp: int, dims: int | None) -> Params:
         """Parameters for a valid ``spp`` (see the subclasses)."""
@@ -82,7 +96,7 @@ class Baseline(Construction):
     more_dims_hint = ""
 
     def valid(self, spp: int) -> bool:
-        if not 1 <= spp <= MAX_SPP:
+        if not 1 <= spp <= self.max_spp:
             return False
         return self.counts == "any" or spp & (spp - 1) == 0
 
@@ -90,7 +104,7 @@ class Baseline(Construction):
         self._check(dims, strength)
         if self.counts == "any":
             return AllCounts(lambda n: self._choice(n, dims))
-        return [self._choice(1 << k, dims) for k in range(MAX_SPP.bit_length())]
+        return [self._choice(1 << k, dims) for k in range(self.max_spp.bit_length())]
 
     def nearest(self, spp, dims=None, strength=None):
         self._check(dims, strength)
@@ -106,7 +120,7 @@ class Baseline(Construction):
 
     def invalid(self, spp, dims, strength):
         if self.counts == "pow2":
-            return f"{spp} is not a power of two in [1, 2^24]"
+            return f"{spp} is not a power of two in [1, 2^{self.max_spp.bit_length() - 1}]"
         return f"{spp} is not in [1, 2^24]"
 
     def options(self, offset, jitter):
@@ -116,7 +130,13 @@ class Baseline(Construction):
     def shape_args(self, params):
         return ()
 
+    def test_cases(self):
+        # one sample, a few, the largest count (its last sample), many dimensions
+        return [dict(spp=1, dims=1), dict(spp=12, dims=5), dict(spp=self.max_spp, dims=3),
+                dict(spp=4, dims=min(self.max_dims, 600))]
 
+
+@register
 class Random(Baseline):
     """``random``: independent uniform values, the paper's "Random".
 
@@ -130,12 +150,16 @@ class Random(Baseline):
 
     name = "random"
     code = 5
+    reference = staticmethod(_reference_baselines.random)
+    numpy = staticmethod(_numpy_baselines.random)
+    kernel = "sample_random(i, j, p)"
     description = "independent uniform random values (no stratification): any N"
 
     def params(self, spp, dims):
         return Params(s=1, strength=0, block_dims=1, M=spp, dims=dims or 0)
 
 
+@register
 class Jittered2D(Baseline):
     """``jittered2d``: padded 2D jittered sampling, the paper's "Jittered2D (pad)".
 
@@ -151,6 +175,10 @@ class Jittered2D(Baseline):
     code = 6
     jittered = True
     counts = "square"
+    vector_kind = 1
+    reference = staticmethod(_reference_baselines.jittered2d)
+    numpy = staticmethod(_numpy_baselines.jittered2d)
+    kernel = "sample_jittered2d(i, j, a, b, p, J)"
     description = "padded 2D jittered: N = m^2, each pair of dimensions an m x m jittered grid"
 
     def valid(self, spp):
@@ -173,7 +201,16 @@ class Jittered2D(Baseline):
     def shape_args(self, params):
         return (params.s, params.dims)
 
+    def claims(self, params, offset):
+        # each pair an m x m jittered grid, each dimension m strata of m points
+        return [Claim("grid", a=params.s, c=params.s), Claim("latin", n=params.s)]
 
+    def test_cases(self):
+        # 1 x 1, an odd dims (a lone last dimension), 4096 x 4096
+        return [dict(spp=1, dims=2), dict(spp=9, dims=5), dict(spp=121, dims=8), dict(spp=MAX_SPP, dims=3)]
+
+
+@register
 class CMJ2D(Baseline):
     """``cmj2d``: padded correlated multi-jittered 2D (Kensler 2013), the paper's "CMJ2D (pad)".
 
@@ -189,6 +226,10 @@ class CMJ2D(Baseline):
     name = "cmj2d"
     code = 7
     jittered = True
+    vector_kind = 2
+    reference = staticmethod(_reference_baselines.cmj2d)
+    numpy = staticmethod(_numpy_baselines.cmj2d)
+    kernel = "sample_cmj2d(i, j, a, b, p, J)"
     description = "padded 2D correlated multi-jittered (Kensler): any N = m x n, the most nearly square grid"
 
     def params(self, spp, dims):
@@ -201,7 +242,16 @@ class CMJ2D(Baseline):
     def shape_args(self, params):
         return (params.s, params.M)
 
+    def claims(self, params, offset):
+        return [Claim("grid", a=params.s, c=params.M), Claim("latin", n=params.s * params.M)]
 
+    def test_cases(self):
+        # a prime (1 x N), 10 x 12, a square, the largest prime below 2^24 and 4093 x 4099
+        return [dict(spp=7, dims=3), dict(spp=120, dims=4), dict(spp=256, dims=6),
+                dict(spp=16777213, dims=2), dict(spp=4093 * 4099, dims=3)]
+
+
+@register
 class Sobol02(Baseline):
     """``sobol02``: padded (0,2)-sequence, the paper's "(0,2)-seq. (pad)".
 
@@ -216,6 +266,9 @@ class Sobol02(Baseline):
     name = "sobol02"
     code = 8
     counts = "pow2"
+    reference = staticmethod(_reference_baselines.sobol02)
+    numpy = staticmethod(_numpy_baselines.sobol02)
+    kernel = "sample_sobol02(i, j, a, p, table)"
     description = "padded (0,2)-sequence, Owen-scrambled and shuffled per pair: N a power of two"
 
     def params(self, spp, dims):
@@ -227,7 +280,14 @@ class Sobol02(Baseline):
     def constants(self, params):
         return sequences.sobol_matrices()[:2]
 
+    def constants_key(self, params):
+        return self.name  # the same two dimensions for every count
 
+    def claims(self, params, offset):
+        return [Claim("net", n=params.M, prefixes=True), Claim("latin", n=params.M)]
+
+
+@register
 class Halton(Baseline):
     """``halton``: Owen-scrambled Halton sequence, the paper's "Halton".
 
@@ -241,6 +301,9 @@ class Halton(Baseline):
 
     name = "halton"
     code = 9
+    reference = staticmethod(_reference_baselines.halton)
+    numpy = staticmethod(_numpy_baselines.halton)
+    kernel = "sample_halton(i, j, p, table)"
     max_dims = sequences.HALTON_MAX_DIMS
     more_dims_hint = " (one prime base below 2^16 each); use sobol (21201) or a padded sampler for more"
     description = f"Owen-scrambled Halton: any N, up to {sequences.HALTON_MAX_DIMS} dimensions"
@@ -248,7 +311,11 @@ class Halton(Baseline):
     def constants(self, params):
         return sequences.primes()
 
+    def constants_key(self, params):
+        return self.name
 
+
+@register
 class Sobol(Baseline):
     """``sobol``: Owen-scrambled Sobol sequence, the paper's "Sobol".
 
@@ -265,6 +332,9 @@ class Sobol(Baseline):
     name = "sobol"
     code = 10
     counts = "pow2"
+    reference = staticmethod(_reference_baselines.sobol)
+    numpy = staticmethod(_numpy_baselines.sobol)
+    kernel = "sample_sobol(i, j, p, table)"
     max_dims = sequences.SOBOL_MAX_DIMS
     more_dims_hint = " (the Joe-Kuo table); use a padded sampler for more"
     description = (f"Owen-scrambled Sobol (Joe-Kuo directions): N a power of two, "
@@ -274,7 +344,6 @@ class Sobol(Baseline):
         V = sequences.sobol_matrices()
         return V[: params.dims] if params.dims else V
 
-
-BASELINES: dict[str, Baseline] = {
-    c.name: c for c in (Random(), Jittered2D(), CMJ2D(), Sobol02(), Halton(), Sobol())
-}
+    def claims(self, params, offset):
+        # every dimension a (0,1)-sequence; dimensions 0 and 1 a (0,2)-sequence
+        return [Claim("net", n=params.M, prefixes=True, pairs=1), Claim("latin", n=params.M)]

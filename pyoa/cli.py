@@ -21,7 +21,9 @@ import numpy as np
 from . import OFFSETS, backends, sampler, samplers, valid_spp
 from .atomic import atomic_path, check_writable
 from .backends import BackendUnavailable, PyoaFallbackWarning
-from .constructions import MAX_UINT32, check_int, get
+from .catalogue import get
+from .catalogue_types import MAX_UINT32, check_int
+from .units import format_rate
 
 FORMATS = (".npy", ".csv")
 #: Values per block of CSV rows written at once (bounds the float64 table).
@@ -75,14 +77,6 @@ def save_points(x: np.ndarray, path: str, pixels: range) -> None:
                     np.savetxt(fh, table, fmt=fmt)
 
 
-def _rate(per_s: float) -> str:
-    """``1234567.0`` -> ``"1.23 M"``."""
-    for unit, scale in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
-        if per_s >= scale:
-            return f"{per_s / scale:.3g} {unit}"
-    return f"{per_s:.3g}"
-
-
 def _pixel_range(args) -> range:
     """``--pixel0`` and ``--pixels`` as the range of pixels (at least one, all uint32)."""
     pixel0 = _option(args, "pixel0", 0, MAX_UINT32)
@@ -105,7 +99,7 @@ def cmd_points(args) -> int:
     if not args.quiet:
         print(smp)
         print(f"{x.size:,} values ({x.shape[0]} pixels x {x.shape[1]} samples x {x.shape[2]} dims) "
-              f"in {dt:.3f} s ({_rate(x.size / max(dt, 1e-9))} values/s) -> {args.out}")
+              f"in {dt:.3f} s ({format_rate(x.size / max(dt, 1e-9))} values/s) -> {args.out}")
     return 0
 
 

@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 from .atomic import atomic_path, check_writable
-from .constructions import MAX_UINT32, check_int
+from .catalogue_types import MAX_UINT32, check_int
 from .samplers import sampler as make_sampler
 
 #: Largest number of dimensions in a projection matrix (D*(D-1)/2 panels).

@@ -19,9 +19,10 @@ import numbers
 import numpy as np
 from scipy.stats import qmc
 
-from . import constructions
-from .constructions import MAX_DIMS, MAX_UINT32
-from .samplers import ENV_MAX_BYTES, Sampler, format_bytes
+from . import catalogue
+from .catalogue_types import MAX_DIMS, MAX_UINT32
+from .samplers import ENV_MAX_BYTES, Sampler
+from .units import format_bytes
 
 __all__ = ["OrthogonalArray", "DEFAULT_SPP_TARGET"]
 
@@ -228,10 +229,10 @@ class OrthogonalArray(qmc.QMCEngine):
         d = int(d)
         if d > MAX_DIMS:
             raise ValueError(f"d must be at most {MAX_DIMS} (2**20), got {d}")
-        if not isinstance(sampler, str) or sampler.lower() not in constructions.SAMPLERS:
+        if not isinstance(sampler, str) or sampler.lower() not in catalogue.SAMPLERS:
             raise ValueError(f"{sampler!r} is not a valid sampler. It must be one of "
-                             f"{list(constructions.SAMPLERS)!r}")
-        name = constructions.SAMPLERS[sampler.lower()].name
+                             f"{list(catalogue.SAMPLERS)!r}")
+        name = catalogue.SAMPLERS[sampler.lower()].name
 
         # SciPy 1.17's engines take `rng` (normalized by np.random.default_rng)
         # and, during the SPEC 7 transition, the legacy `seed` (used as given).
@@ -245,7 +246,7 @@ class OrthogonalArray(qmc.QMCEngine):
             super().__init__(d=d, optimization=optimization, seed=rng)
 
         if spp is None:
-            spp = constructions.nearest_spp(name, DEFAULT_SPP_TARGET, dims=d, strength=strength)
+            spp = catalogue.nearest_spp(name, DEFAULT_SPP_TARGET, dims=d, strength=strength)
             if spp is None:
                 raise ValueError(f"{name} has no valid sample count for d={d}, strength={strength}")
         self.pyoa_seed = _draw_seed(self.rng)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .constructions import Construction, Params
+from .catalogue_types import Construction, Params
 
 
 @dataclass(frozen=True)

@@ -23,10 +23,11 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from . import constructions, reference
+from . import catalogue
 from .backends import choose
-from .constructions import MAX_DIMS, MAX_SPP, MAX_UINT32, OFFSETS, check_int
+from .catalogue_types import MAX_DIMS, MAX_SPP, MAX_UINT32, OFFSETS, check_int
 from .request import Request
+from .units import format_bytes
 
 ENV_MAX_BYTES = "PYOA_MAX_BYTES"
 _UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
@@ -34,7 +35,7 @@ _UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
 
 def samplers() -> dict[str, str]:
     """The sampler names :func:`sampler` accepts, each with a one-line description."""
-    return {name: c.description for name, c in constructions.SAMPLERS.items()}
+    return {name: c.description for name, c in catalogue.SAMPLERS.items()}
 
 
 def _physical_memory() -> int:
@@ -133,15 +134,6 @@ def default_max_bytes() -> int:
     """``$PYOA_MAX_BYTES`` if set (see :func:`parse_bytes`), else half of the physical memory."""
     env = os.environ.get(ENV_MAX_BYTES)
     return parse_bytes(env, f"${ENV_MAX_BYTES}") if env else _physical_memory() // 2
-
-
-def format_bytes(n: float) -> str:
-    """``1536`` -> ``"1.5 KiB"`` (binary units, for memory-limit messages)."""
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if n < 1024 or unit == "PiB":
-            return f"{int(n)} B" if unit == "B" else f"{n:.1f} {unit}" if n < 1e6 else f"{n:.3g} {unit}"
-        n /= 1024
-    return f"{n} B"  # pragma: no cover
 
 
 _int = check_int  # the checker of every count argument (pyoa.analysis uses it too)
@@ -282,6 +274,12 @@ class Sampler:
         Jitter amount in [0, 1] (as float32); 1 for samplers without one.
     seed : int
         User seed (uint32).
+    resolution : tuple of int or None
+        ``(width, height)`` of the image for the samplers whose values depend
+        on where a pixel lies in it (``zsobol``), else None.
+    n_pixels : int
+        How many pixel indices are valid: ``width * height`` with a
+        resolution (pixel ``y * width + x``), else ``2**32``.
     backend : str
         ``"opencl"`` or ``"numpy"``; ``device`` describes what it runs on.
     max_bytes : int
@@ -289,9 +287,9 @@ class Sampler:
         values plus its uint32 index arrays.
     """
 
-    def __init__(self, name, *, spp, dims, seed=0, offset=None, jitter=1.0, strength=None,
+    def __init__(self, name, *, spp, dims, seed=0, offset=None, jitter=1.0, strength=None, resolution=None,
                  backend=None, device=None, max_bytes=None):
-        construction = constructions.get(name)
+        construction = catalogue.get(name)
         spp = _int("spp", spp, 1, MAX_SPP)
         dims = _int("dims", dims, 1, MAX_DIMS)
         seed = _int("seed", seed, 0, MAX_UINT32)
@@ -299,13 +297,14 @@ class Sampler:
             strength = _int("strength", strength, 1)
         offset = _offset(construction, offset)
         jitter = _jitter(construction, jitter)
-        params = construction.resolve(spp, dims, strength)
+        params = construction.with_resolution(construction.resolve(spp, dims, strength), resolution)
         max_bytes = default_max_bytes() if max_bytes is None else parse_bytes(max_bytes, "max_bytes")
         impl = choose(backend, device)
         # Every attribute is set here and never again (see __setattr__).
         fields = dict(
             _construction=construction, name=construction.name, spp=spp, dims=dims, seed=seed, offset=offset,
             jitter=jitter, params=params, s=params.s, strength=params.strength, block_dims=params.block_dims,
+            resolution=params.resolution, n_pixels=construction.pixel_count(params),
             max_bytes=max_bytes, _backend=impl, _device_selector=device, backend=impl.name,
             device=impl.describe(),
         )
@@ -326,7 +325,7 @@ class Sampler:
             spp=self.spp, dims=self.dims, seed=self.seed, offset=self.offset, jitter=self.jitter,
             # the resolved strength, so the copy cannot resolve another one; the
             # comparison samplers take none
-            strength=self.strength if self._construction.family == "oa" else None,
+            strength=self.strength if self._construction.family == "oa" else None, resolution=self.resolution,
             backend=self.backend, device=self._device_selector, max_bytes=self.max_bytes,
         )
 
@@ -343,7 +342,8 @@ class Sampler:
             grid = c.detail(self.params)
             return (
                 f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}"
-                f"{f', jitter={self.jitter:g}' if c.jittered else ''}{f'; grid {grid}' if grid else ''}; "
+                f"{f', jitter={self.jitter:g}' if c.jittered else ''}"
+                f"{f', resolution={self.resolution}' if self.resolution else ''}{f'; grid {grid}' if grid else ''}; "
                 f"backend={self.backend!r} on {self.device})"
             )
         return (
@@ -360,7 +360,7 @@ class Sampler:
             seed=self.seed,
             offset=self.offset,
             jitter=self.jitter,
-            pixels=_indices("pixels", pixels, MAX_UINT32 + 1),
+            pixels=_indices("pixels", pixels, self.n_pixels),
             samples=_indices("samples", samples, self.spp),
             dims=_indices("dims", dims, self.dims),
         )
@@ -373,7 +373,7 @@ class Sampler:
         pixels = [0] if pixels is None else pixels
         samples = range(self.spp) if samples is None else samples
         dims = range(self.dims) if dims is None else dims
-        n_p = _index_length("pixels", pixels, MAX_UINT32 + 1)
+        n_p = _index_length("pixels", pixels, self.n_pixels)
         n_s = _index_length("samples", samples, self.spp)
         n_d = _index_length("dims", dims, self.dims)
         nbytes = 4 * n_p * n_s * n_d + INDEX_BYTES * (n_p + n_s + n_d)
@@ -392,7 +392,8 @@ class Sampler:
         Parameters
         ----------
         pixels : range or sequence of int, optional
-            Pixel indices in ``[0, 2**32)``; default ``[0]``.
+            Pixel indices in ``[0, 2**32)`` (``[0, width * height)`` for a
+            sampler with a ``resolution``, row-major); default ``[0]``.
         samples : range or sequence of int, optional
             Sample indices in ``[0, spp)``; default every sample.
         dims : range or sequence of int, optional
@@ -466,11 +467,11 @@ class Sampler:
         Returns the float32 value ``x(pixel, i, j)`` as a Python float; it has
         the same bits as the corresponding entry of :meth:`generate`.
         """
-        pixel = _int("pixel", pixel, 0, MAX_UINT32)
+        pixel = _int("pixel", pixel, 0, self.n_pixels - 1)
         i = _int("i", i, 0, self.spp - 1)
         j = _int("j", j, 0, self.dims - 1)
-        p = reference.pixel_seed(self.seed, pixel)
-        return float(self._construction.call("pyoa.reference", i, j, self.params, p, self.offset, self.jitter))
+        return float(self._construction.evaluate("reference", i, j, self.params, self.seed, pixel, self.offset,
+                                                 self.jitter))
 
 
 def _rebuild(name: str, arguments: dict) -> Sampler:
@@ -520,8 +521,8 @@ def _output(out, shape: tuple[int, ...]) -> np.ndarray:
 
 
 def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None = None, jitter: float = 1.0,
-            strength: int | None = None, backend: str | None = None, device: str | None = None,
-            max_bytes: int | float | str | None = None) -> Sampler:
+            strength: int | None = None, resolution: tuple[int, int] | None = None, backend: str | None = None,
+            device: str | None = None, max_bytes: int | float | str | None = None) -> Sampler:
     """Create a sampler: an orthogonal array or one of the paper's comparison samplers.
 
     Parameters
@@ -557,6 +558,12 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
     strength : int, optional
         ``bush`` and ``cmjnd``: t, so ``spp = s**t``. Default: the largest
         ``t <= dims`` (``t >= 2``) for which ``spp`` is a perfect t-th power.
+    resolution : (int, int), optional
+        ``(width, height)`` of the image, required by the samplers whose
+        values depend on where a pixel lies in the image (``zsobol``: its
+        Morton order spans the image) and refused by the others. Pixels are
+        then numbered row-major, ``pixel = y * width + x`` (as pyoa's
+        renderer numbers them), and must be below ``width * height``.
     backend : {"opencl", "numpy"}, optional
         Default: ``$PYOA_BACKEND``, else OpenCL if usable, else NumPy with a
         warning (see :mod:`pyoa.backends`).
@@ -588,4 +595,4 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
     True
     """
     return Sampler(name, spp=spp, dims=dims, seed=seed, offset=offset, jitter=jitter, strength=strength,
-                   backend=backend, device=device, max_bytes=max_bytes)
+                   resolution=resolution, backend=backend, device=device, max_bytes=max_bytes)

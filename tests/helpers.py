@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 
 import pyoa
-from pyoa import reference as ref
 
 U32_MAX = 2**32 - 1
 OFFSET_CODE = {"centered": 0, "j": 1, "mj": 2, "cmj": 3}
@@ -90,24 +89,15 @@ def assert_same_bits(got, want, what: str = "") -> None:
 
 def reference_block(smp, pixels, samples, dims) -> np.ndarray:
     """What ``smp.generate(pixels, samples, dims)`` must return, from the pure-Python
-    reference functions (pixel seeds from ``pyoa.reference.pixel_seed``)."""
+    reference function that the sampler's catalogue entry names (pixel seeds
+    from ``pyoa.reference.pixel_seed``), one value at a time."""
+    entry = smp._construction
     out = np.empty((len(pixels), len(samples), len(dims)), dtype=np.float32)
     for a, pix in enumerate(pixels):
-        p = ref.pixel_seed(smp.seed, int(pix))
         for b, i in enumerate(samples):
             for c, j in enumerate(dims):
-                if smp.name == "bose":
-                    out[a, b, c] = ref.bose(int(i), int(j), smp.s, p, smp.offset, smp.jitter)
-                elif smp.name == "bush":
-                    out[a, b, c] = ref.bush(int(i), int(j), smp.s, smp.strength, p, smp.offset, smp.jitter)
-                elif smp.name == "cmjnd":
-                    out[a, b, c] = ref.cmjnd(int(i), int(j), smp.s, smp.strength, p, smp.offset, smp.jitter)
-                elif smp.name == "addelman-kempthorne":
-                    out[a, b, c] = ref.addelman_kempthorne(int(i), int(j), smp.s, p, smp.offset, smp.jitter)
-                elif smp.name == "bose-bush":
-                    out[a, b, c] = ref.bose_bush(int(i), int(j), smp.s, p, smp.offset, smp.jitter)
-                else:  # a new construction must be added here, not silently compared to another one
-                    raise AssertionError(f"reference_block does not know sampler {smp.name!r}")
+                out[a, b, c] = entry.evaluate("reference", int(i), int(j), smp.params, smp.seed, int(pix),
+                                              smp.offset, smp.jitter)
     return out
 
 

@@ -23,6 +23,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 import pyoa
+import pyoa.catalogue
 import pyoa._numpy.backend as numpy_backend
 from pyoa import reference as ref
 from pyoa import sequences
@@ -312,7 +313,7 @@ def test_largest_spp(backend, name, spp, dims):
 
 def test_catalogue_grids():
     """The grids the edge cases rely on (a prime gives 1 x N; Halton's first and last bases)."""
-    c = pyoa.baselines.BASELINES["cmj2d"]
+    c = pyoa.catalogue.SAMPLERS["cmj2d"]
     assert (c.params(BIG_PRIME, 3).s, c.params(BIG_PRIME, 3).M) == (1, BIG_PRIME)
     assert (c.params(TWIN, 3).s, c.params(TWIN, 3).M) == (4093, 4099)
     assert (c.params(MAX_SPP, 3).s, c.params(MAX_SPP, 3).M) == (4096, 4096)

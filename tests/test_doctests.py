@@ -22,7 +22,8 @@ import pytest
 #: module -> the fewest examples it must have
 MIN_EXAMPLES = {
     "pyoa.samplers": 5,
-    "pyoa.constructions": 2,
+    "pyoa.catalogue": 2,
+    "pyoa.hashes": 1,
     "pyoa.analysis": 13,
     "pyoa.qmc": 20,
 }

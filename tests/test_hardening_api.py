@@ -16,7 +16,7 @@ import pytest
 
 import pyoa
 from pyoa import analysis as A
-from pyoa import constructions
+from pyoa import catalogue as constructions
 from pyoa.samplers import _physical_memory, parse_bytes
 from tests.helpers import assert_same_bits
 

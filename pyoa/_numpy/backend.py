@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import host_tables
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from ..request import Rect, Request
 from . import oa
 from .floats import F32
-from .hashes import U32, permute, pixel_seed
+from .hashes import U32, permute
 
 #: Values per chunk: bounds the temporaries (about 20 arrays of this size).
 CHUNK_VALUES = 1 << 20
@@ -47,18 +48,19 @@ class NumpyBackend:
         rows = np.arange(rect.row0, rect.row1, dtype=np.int64)
         n_s = len(req.samples)
         i = req.samples[rows % n_s][:, None]
-        p = pixel_seed(req.seed, req.pixels[rows // n_s])[:, None]
-        out[...] = req.construction.call("pyoa._numpy", i, req.dims[None, :], req.params, p, req.offset, req.jitter)
+        pixel = req.pixels[rows // n_s][:, None]
+        out[...] = req.construction.evaluate("numpy", i, req.dims[None, :], req.params, req.seed, pixel,
+                                             req.offset, req.jitter)
 
     @staticmethod
     def _tabled(req: Request, rect: Rect) -> np.ndarray:
         """Values of ``rect`` as ``(pixels, samples, dims)``: the per-(pixel,
         dimension) permutations computed once, the pixel-independent cells
-        (:func:`.oa.cells`) once, then one gather per value."""
+        (:func:`pyoa.host_tables.cells`) once, then one gather per value."""
         prm = req.params
         s, M = prm.s, prm.M
-        q = oa.column_keys(req, rect.pix0, rect.pix1)  # (pixels, dims)
-        aij, u = (c.T for c in oa.cells(req, rect.k0, rect.k1))  # (samples, dims)
+        q = host_tables.column_keys(req, rect.pix0, rect.pix1)  # (pixels, dims)
+        aij, u = (c.T for c in host_tables.cells(req, rect.k0, rect.k1))  # (samples, dims)
         d = np.arange(req.n_dims)
         strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])  # (pixels, dims, s)
         stratum = strata[:, d, aij]  # (pixels, samples, dims)

@@ -8,15 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..hashes import U32, _u32, block_seed, hash_pair, mix32, pixel_seed  # noqa: F401  (this package's hashes)
 from ..reference.floats import UNIT_SCALE
-from ..reference.hashes import BLOCK_KEY, JITTER_KEY, PIXEL_KEY, STRATUM_KEY, SUBSTRATUM_KEY
+from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 
-U32 = np.uint32
 _UNIT_SCALE = np.float32(UNIT_SCALE)
-
-
-def _u32(x) -> np.ndarray:
-    return np.asarray(x, dtype=U32)
 
 
 def _permute_round(i: np.ndarray, p: np.ndarray, w: np.uint32) -> np.ndarray:
@@ -88,34 +84,6 @@ def randfloat(i, p) -> np.ndarray:
     r = i.astype(np.float32) * _UNIT_SCALE
     zero = p == 0
     return (np.where(zero, np.float32(0.5), r) if np.any(zero) else r).reshape(shape)
-
-
-def mix32(x) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.mix32` (Wellons' lowbias32)."""
-    x = _u32(x).copy()
-    x ^= x >> U32(16)
-    x *= U32(0x7FEB352D)
-    x ^= x >> U32(15)
-    x *= U32(0x846CA68B)
-    x ^= x >> U32(16)
-    return x
-
-
-def hash_pair(a, b, key: int) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.hashes.hash_pair` (never 0)."""
-    h = mix32(_u32(b) ^ mix32(_u32(a) ^ U32(key)))
-    return np.where(h == 0, U32(key), h)
-
-
-def pixel_seed(seed, pixel) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.pixel_seed`."""
-    return hash_pair(seed, pixel, PIXEL_KEY)
-
-
-def block_seed(p, block) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.block_seed` (block 0 keeps ``p``)."""
-    p, block = np.broadcast_arrays(_u32(p), _u32(block))
-    return np.where(block == 0, p, hash_pair(p, block, BLOCK_KEY))
 
 
 def dimension_seeds(p, j):

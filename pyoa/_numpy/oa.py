@@ -17,7 +17,7 @@ import numpy as np
 from .. import gf
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import F32, jitter_value, sample_value
-from .hashes import U32, block_seed, permute, pixel_seed, randfloat
+from .hashes import U32, block_seed, permute, randfloat
 
 
 def column_key(p, j, dmax: int) -> np.ndarray:
@@ -199,69 +199,3 @@ def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.
 def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bose_bush` (parameters assumed valid)."""
     return _index2(bose_bush_cell, i, j, s, p, offset, jitter)
-
-
-#: construction name -> ``(i, col, params) -> (A_ij, u)``, the cell of sample
-#: ``i`` in column ``col`` and its sub-stratum index (Bose: the partner
-#: column's entry).
-CELLS = {
-    "bose": lambda i, col, prm: bose_cell(i, col, prm.s),
-    "bush": lambda i, col, prm: bush_cell(i, col, prm.s, prm.strength),
-    "cmjnd": lambda i, col, prm: cmjnd_cell(i, col, prm.s),
-    "addelman-kempthorne": lambda i, col, prm: addelman_kempthorne_cell(i, col, prm.s),
-    "bose-bush": lambda i, col, prm: bose_bush_cell(i, col, prm.s),
-}
-
-
-def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(A_ij, u)`` of sample positions ``[k0, k1)`` of request ``req`` in each
-    of its dimensions: two C-contiguous uint32 arrays of shape
-    ``(n_dims, k1 - k0)``.
-
-    A cell depends on the sample and the column only, not on the pixel, so the
-    table path computes it once per rectangle of pixels x samples and gathers
-    the pixel's permutations with it (both backends; the OpenCL kernel
-    ``generate_cells`` reads exactly these arrays, and the vector path of
-    :mod:`pyoa._opencl.vector` the same, padded). ``u`` is 0 for the
-    ``centered`` offset, which has no sub-stratum.
-    """
-    prm = req.params
-    i = req.samples[k0:k1][None, :]
-    col = (req.dims % U32(prm.block_dims))[:, None]
-    aij, u = CELLS[req.construction.name](i, col, prm)
-    shape = (req.n_dims, k1 - k0)
-    aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
-    if req.offset == "centered":
-        return aij, np.zeros(shape, U32)
-    return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
-
-
-def column_keys(req, pix0: int, pix1: int) -> np.ndarray:
-    """:func:`column_key` of every (pixel, dimension) of pixels ``[pix0, pix1)``
-    of request ``req``, shape ``(pixels, n_dims)``.
-
-    The block seed is hashed once per pixel and distinct block, not per
-    (pixel, dimension): requests have few blocks and many dimensions per
-    block."""
-    dmax = req.params.block_dims
-    p = pixel_seed(req.seed, req.pixels[pix0:pix1])
-    if len(p) == 0 or req.n_dims == 0:
-        return np.empty((len(p), req.n_dims), dtype=U32)
-    blocks, which = np.unique(req.dims // U32(dmax), return_inverse=True)
-    seeds = np.stack([block_seed(p, b) for b in blocks], axis=1)  # (pixels, distinct blocks)
-    return seeds[:, which] * (req.dims % U32(dmax) + U32(1))
-
-
-def table_keys(req, pix0: int, pix1: int) -> np.ndarray:
-    """Per (pixel, dimension) of pixels ``[pix0, pix1)``: the column key ``q``
-    (:func:`column_keys`) and the final shifts ``q * STRATUM_KEY % s`` and
-    ``q * SUBSTRATUM_KEY % M`` of its two permutations, as a C-contiguous
-    uint32 array of shape ``(pixels, n_dims, 3)`` (the OpenCL ``tables``
-    kernel reads it)."""
-    prm = req.params
-    q = column_keys(req, pix0, pix1)
-    out = np.empty((*q.shape, 3), dtype=U32)
-    out[..., 0] = q
-    np.remainder(q * U32(STRATUM_KEY), U32(prm.s), out=out[..., 1])
-    np.remainder(q * U32(SUBSTRATUM_KEY), U32(prm.M), out=out[..., 2])
-    return out

@@ -6,7 +6,7 @@ import threading
 
 import numpy as np
 
-from .. import constructions, gf
+from .. import catalogue_types, gf
 from ..request import Rect, Request
 from . import vector
 from .choice import open_device
@@ -99,7 +99,7 @@ class OpenCLBackend:
         primes, Sobol's direction numbers), uploaded once per (sampler,
         parameters); a 1-element placeholder when there are none. Called with
         self._lock held."""
-        key = (req.construction.name, req.params)
+        key = req.construction.constants_key(req.params)
         if key not in self._consts:
             import pyopencl as cl
 
@@ -186,15 +186,15 @@ class OpenCLBackend:
                 buf = self._scratch("out", n_values * 4)
             dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
             if req.construction.family == "baseline":
-                a, b = (*req.construction.shape_args(prm), 0, 0)[:2]
+                a, b, c = (*req.construction.shape_args(prm), 0, 0, 0)[:3]
                 kernel = f"generate_{req.construction.function}"
-                extra = (np.uint32(req.seed), np.uint32(a), np.uint32(b), np.float32(req.jitter),
+                extra = (np.uint32(req.seed), np.uint32(a), np.uint32(b), np.uint32(c), np.float32(req.jitter),
                          self._constants(req))
             else:
                 kernel = "generate"
                 extra = (np.uint32(req.seed), np.uint32(req.construction.code),
                          np.uint32(prm.s), np.uint32(prm.strength),
-                         np.uint32(constructions.OFFSET_CODES[req.offset]), np.float32(req.jitter),
+                         np.uint32(catalogue_types.OFFSET_CODES[req.offset]), np.float32(req.jitter),
                          *self._field(req.construction.field_order(prm)), self._constants(req))
             use_vector = self.path == "vector" and (
                 self.path_forced or req.n_rows * req.n_dims >= VECTOR_MIN_VALUES)
@@ -279,7 +279,7 @@ class OpenCLBackend:
         self._lock held."""
         import pyopencl as cl
 
-        from .._numpy.oa import cells, table_keys
+        from ..host_tables import cells, table_keys
 
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         prm = req.params

@@ -1,10 +1,11 @@
 """Building pyoa's OpenCL program once per process and device.
 
-The sources of :mod:`pyoa.kernels` are concatenated in order and built with
-``-D`` defines carrying Python-side constants into them (:func:`defines`: the
-construction and offset codes of :mod:`pyoa.constructions`, the hash keys of
-:mod:`pyoa.reference.hashes` and :mod:`pyoa.reference.baselines`, which the
-``.cl`` files never copy) and ``-cl-fp32-correctly-rounded-divide-sqrt`` (SPEC
+The sources of :mod:`pyoa.kernels` are concatenated in order, followed by
+the dispatch generated from the catalogue (:func:`dispatch_source`), and
+built with ``-D`` defines carrying Python-side constants into them
+(:func:`defines`: the construction and offset codes of
+:mod:`pyoa.catalogue`, the hash keys of the :mod:`pyoa.reference` modules,
+which the ``.cl`` files never copy) and ``-cl-fp32-correctly-rounded-divide-sqrt`` (SPEC
 section 7). Never add ``-cl-fast-relaxed-math`` or ``-cl-mad-enable``: they
 break bit-exactness. PoCL caches the compiled binary on disk (``~/.cache/pocl``),
 so later processes build fast.
@@ -20,7 +21,8 @@ import tempfile
 import threading
 from importlib import resources
 
-from .. import constructions
+from .. import catalogue
+from ..catalogue_types import OFFSET_CODES
 from .device import DeviceInfo
 
 BUILD_OPTIONS = ["-cl-fp32-correctly-rounded-divide-sqrt"]
@@ -60,23 +62,49 @@ def kernel_keys() -> dict[str, int]:
 def defines() -> list[str]:
     """``-D`` options carrying the Python-side integer codes and hash keys into
     the kernels (keys as uint literals: ``-DSTRATUM_KEY=0x51633e2du``)."""
-    opts = [f"-DOFFSET_{name.upper()}={code}" for name, code in constructions.OFFSET_CODES.items()]
-    opts += [f"-DCONSTRUCTION_{c.function.upper()}={c.code}" for c in constructions.SAMPLERS.values()]
+    opts = [f"-DOFFSET_{name.upper()}={code}" for name, code in OFFSET_CODES.items()]
+    opts += [f"-DCONSTRUCTION_{c.function.upper()}={c.code}" for c in catalogue.SAMPLERS.values()]
     opts += [f"-D{name}=0x{value:08x}u" for name, value in kernel_keys().items()]
     return opts
 
 
+def dispatch_source() -> str:
+    """The kernels' dispatch, generated from the catalogue's entries.
+
+    ``oa_dispatch`` (called by ``generate`` in kernels/generate.cl, which
+    declares it) has one ``case`` per orthogonal-array entry, evaluating its
+    ``kernel`` expression; its ``default`` (an unregistered code, which the
+    host never launches) gives NaN, never another construction's value. Each
+    comparison sampler gets its own kernel ``generate_<name>``
+    (``GENERATE_BASELINE``). Registering an entry is all it takes."""
+    entries = list(catalogue.SAMPLERS.values())
+    lines = [
+        "/* ---- generated from the catalogue (pyoa._opencl.program.dispatch_source) ---- */",
+        "float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint p, uint offset, float J,",
+        "               __global const ushort *gf, uint gf_tabled, __global const uint *consts)",
+        "{",
+        "    switch (construction) {",
+    ]
+    lines += [f"    case CONSTRUCTION_{c.function.upper()}: return {c.kernel};" for c in entries if c.family == "oa"]
+    lines += ["    default: return NAN;  /* not a registered construction */", "    }", "}"]
+    lines += [f"GENERATE_BASELINE({c.function}, {c.kernel})" for c in entries if c.family != "oa"]
+    return "\n".join(lines) + "\n"
+
+
 def source(names: tuple[str, ...] | None = None) -> str:
     """The program text: the files ``names`` of :mod:`pyoa.kernels` (default
-    :data:`pyoa.kernels.SOURCES`), in that order."""
+    :data:`pyoa.kernels.SOURCES`), in that order, then (with
+    ``generate.cl``) :func:`dispatch_source`."""
     from .. import kernels
 
+    names = names or kernels.SOURCES
     root = resources.files(kernels)
     # The pragma applies from where it appears to the end of the program:
     # first, so no float operation of any file can be contracted into an FMA.
-    return "#pragma OPENCL FP_CONTRACT OFF\n" + "\n".join(
-        f"/* ---- {name} ---- */\n" + root.joinpath(name).read_text() for name in (names or kernels.SOURCES)
+    text = "#pragma OPENCL FP_CONTRACT OFF\n" + "\n".join(
+        f"/* ---- {name} ---- */\n" + root.joinpath(name).read_text() for name in names
     )
+    return text + ("\n" + dispatch_source() if "generate.cl" in names else "")
 
 
 class BuildError(RuntimeError):

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import constructions
+from .. import catalogue_types
 from ..reference.hashes import walk_mask
 from ..request import Rect, Request
 
@@ -108,14 +108,10 @@ class Shape(_Rows):
         """The ``#define`` lines that open the program text."""
         return self._header({
             "VS": f"{self.s}u", "VM": f"{self.M}u", "VWS": f"{walk_mask(self.s)}u", "VWM": f"{walk_mask(self.M)}u",
-            "VDMAX": f"{self.block_dims}u", "VOFFSET": constructions.OFFSET_CODES[self.offset],
+            "VDMAX": f"{self.block_dims}u", "VOFFSET": catalogue_types.OFFSET_CODES[self.offset],
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
         })
-
-
-#: Comparison samplers with a vector kernel, and their kind (VBASELINE).
-BASELINE_KINDS = {"jittered2d": 1, "cmj2d": 2}
 
 
 @dataclass(frozen=True)
@@ -146,8 +142,8 @@ class BaselineShape(_Rows):
 def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:
     """The vector program of a ``jittered2d`` or ``cmj2d`` rectangle, or None
     (other samplers, and the limits of :func:`shape`)."""
-    kind = BASELINE_KINDS.get(req.construction.name)
-    if kind is None or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_DIMS:
+    kind = req.construction.vector_kind  # its catalogue entry names the kernel (VBASELINE), or 0
+    if not kind or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_DIMS:
         return None
     a, b = req.construction.shape_args(req.params)
     shp = BaselineShape(kind, a, b, req.n_dims, rect.n_k)
@@ -175,7 +171,7 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     else:
         return None
     return Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
-                 req.construction.name == "bose")
+                 req.construction.partner_cell_key)
 
 
 def store_code(n_dims: int, tail: int) -> tuple[str, str]:
@@ -237,7 +233,7 @@ def cell_arrays(req: Request, shp: Shape) -> tuple[np.ndarray, np.ndarray, np.nd
     """``(A_ij, u, sample indices)`` of every sample position, the cells laid
     out ``[d][k]`` and every row padded with zeros to whole blocks (the
     kernel's ``vload8`` reads whole blocks; padded lanes are never stored)."""
-    from .._numpy.oa import cells
+    from ..host_tables import cells
 
     aij, u = cells(req, 0, shp.n_k)
     pad = shp.n_k_padded - shp.n_k

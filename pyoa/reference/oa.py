@@ -28,9 +28,11 @@ References
 from __future__ import annotations
 
 from .. import gf
-from ..constructions import OFFSETS
 from .floats import f32, jitter_value, sample_value
 from .hashes import MASK, block_seed, dimension_seeds, permute, randfloat
+
+#: Offset styles of docs/spec.md section 4, in the order of their kernel codes.
+OFFSETS = ("centered", "j", "mj", "cmj")
 
 
 def _check_common(i: int, N: int, j: int, p: int, offset: str, jitter: float) -> float:

@@ -12,12 +12,22 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import constructions
+from .. import catalogue
 from ..atomic import atomic_path
-from ..cli import _rate
-from ..constructions import MAX_SPP, MAX_UINT32, check_int
-from .image import (EXR, PNG, check_crop, check_finite, check_output, check_writable, read_reference, rel_mse,
-                    write_exr, write_png)
+from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
+from ..units import format_rate
+from .image import (
+    EXR,
+    PNG,
+    check_crop,
+    check_finite,
+    check_output,
+    check_writable,
+    read_reference,
+    rel_mse,
+    write_exr,
+    write_png,
+)
 from .layout import MAX_DEPTH
 from .render import SHADINGS, check_memory, plan, render, resolve_shading
 from .scene import load
@@ -86,7 +96,7 @@ def cmd_render(args) -> int:
     if not args.quiet:
         h, w = res.image.shape[:2]
         print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
-        print(f"{res.seconds:.2f} s, {_rate(res.paths_per_second)}paths/s, {_rate(res.rays_per_second)}rays/s "
+        print(f"{res.seconds:.2f} s, {format_rate(res.paths_per_second)}paths/s, {format_rate(res.rays_per_second)}rays/s "
               f"-> {args.out}{' and ' + args.png if args.png else ''}")
     if ref is not None:
         line = f"relMSE {rel_mse(res.image, ref):.6g}"
@@ -114,13 +124,13 @@ def cmd_compare(args) -> int:
         raise ValueError(f"--samplers {args.samplers!r} names no sampler; give a comma-separated list such as "
                          "bose,sobol (see pyoa samplers)")
     for n in names:
-        constructions.get(n)  # unknown names fail before any rendering
+        catalogue.get(n)  # unknown names fail before any rendering
     _check_counts(args)
     md_path, csv_path, png_path = _compare_outputs(args.out)
     scene = load(args.scene)
     jobs = []
     for name in names:  # every sampler's render is checked before the first one starts
-        spp = constructions.nearest_spp(name, args.spp)
+        spp = catalogue.nearest_spp(name, args.spp)
         p = _plan(scene, args, name, spp)
         _check_job_memory(p, f"pyoa compare of {p.width} x {p.height} at {spp} spp ({name})")
         jobs.append((name, spp))

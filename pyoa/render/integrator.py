@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._numpy.hashes import U32, hash_pair
+from ..hashes import U32, hash_pair
 from . import bsdf
 from .camera import FILTERS, PerspectiveCamera, filter_offsets
 from .emitters import Emitters

@@ -18,9 +18,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constructions import MAX_UINT32
-from ..samplers import ENV_MAX_BYTES, default_max_bytes, format_bytes, parse_bytes
+from ..catalogue_types import MAX_UINT32
+from ..samplers import ENV_MAX_BYTES, default_max_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
+from ..units import format_bytes
 from .camera import FILTERS
 from .integrator import Integrator, Stats
 from .layout import MAX_DEPTH, Layout

@@ -247,7 +247,7 @@ def ak_consts(opencl):
     """``q -> buffer`` of [kappa, b, k, c], as the backend uploads it (Construction.constants)."""
     import pyopencl as cl
 
-    from pyoa import constructions
+    from pyoa import catalogue as constructions
 
     def buf(q):
         c = constructions.get("addelman-kempthorne")

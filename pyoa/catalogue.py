@@ -1,0 +1,102 @@
+"""The catalogue: every sampler pyoa has, registered once.
+
+:data:`SAMPLERS` maps each name to its entry (:mod:`pyoa.catalogue_types`):
+the orthogonal-array constructions of :mod:`pyoa.constructions`, then the
+comparison samplers of :mod:`pyoa.baselines`. Everything that lists, looks
+up or dispatches samplers reads it: :func:`pyoa.samplers`, the backends, the
+kernel dispatch (:func:`pyoa._opencl.program.dispatch_source`), the CLI and
+the test suites.
+"""
+
+from __future__ import annotations
+
+from . import baselines, constructions  # noqa: F401  (importing them registers their entries)
+from .catalogue_types import MAX_DIMS, REGISTRY, Construction, SppChoice, check_int
+
+#: Every sampler: the OA constructions, then the comparison samplers.
+SAMPLERS: dict[str, Construction] = {
+    **{n: c for n, c in REGISTRY.items() if c.family == "oa"},
+    **{n: c for n, c in REGISTRY.items() if c.family != "oa"},
+}
+
+
+def names(family: str | None = None) -> list[str]:
+    """The sampler names, of one family (``"oa"`` or ``"baseline"``) or all."""
+    return [n for n, c in SAMPLERS.items() if family is None or c.family == family]
+
+
+def get(name: str) -> Construction:
+    """Look up a construction by name, with an error that lists the valid ones."""
+    if not isinstance(name, str):
+        raise TypeError(f"sampler name must be a str, got {type(name).__name__}")
+    try:
+        return SAMPLERS[name.lower()]
+    except KeyError:
+        raise ValueError(f"unknown sampler {name!r}; valid: {', '.join(SAMPLERS)}") from None
+
+
+def valid_spp(name: str, near: int | None = None, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
+    """List the valid sample counts of a sampler.
+
+    Parameters
+    ----------
+    name : str
+        Sampler name, see :func:`pyoa.samplers`.
+    near : int, optional
+        If given, only the two counts closest to ``near`` (or ``near`` itself
+        and its closest neighbour if it is valid).
+    dims : int, optional
+        Number of dimensions the sampler will be asked for; for ``cmjnd``
+        without ``strength`` it bounds the strengths considered (2..dims).
+    strength : int, optional
+        Restrict to one strength t.
+
+    Returns
+    -------
+    sequence of SppChoice
+        ``(spp, s, strength, block_dims, detail)`` tuples in increasing
+        ``spp``. For ``random``, ``cmj2d`` and ``halton``, which accept every
+        count in ``[1, 2**24]``, a lazy sequence of all 16.7 million.
+
+    Examples
+    --------
+    >>> [c.label() for c in valid_spp("bose", near=120)]
+    ['81 (s=9)', '121 (s=11)']
+    >>> [c.label() for c in valid_spp("sobol", near=120)]
+    ['64 (2^6)', '128 (2^7)']
+
+    Raises
+    ------
+    ValueError
+        An unknown sampler; a negative ``near``; ``dims`` outside
+        ``[1, 2**20]``; a ``strength`` the sampler does not have (as
+        :func:`pyoa.sampler` refuses it: ``bose`` has strength 2 only,
+        ``bush`` 2..8...), rather than an empty list.
+    TypeError
+        A name that is not a str, or a count that is not an int.
+    """
+    construction = get(name)
+    near = None if near is None else check_int("near", near, 0)
+    dims = None if dims is None else check_int("dims", dims, 1, MAX_DIMS)
+    strength = None if strength is None else check_int("strength", strength, 1)
+    construction.solve(1, dims, strength)  # raises for a strength (or dims) this sampler cannot have
+    return _listing(construction, near, dims, strength)
+
+
+def _listing(construction: Construction, near: int | None, dims: int | None, strength: int | None):
+    """:func:`valid_spp` of arguments already checked (or to be taken as they are)."""
+    if near is None:
+        return construction.choices(dims=dims, strength=strength)
+    return construction.nearest(int(near), dims=dims, strength=strength)
+
+
+def nearest_spp(name: str, spp: int, dims: int | None = None, strength: int | None = None) -> int | None:
+    """The valid sample count of ``name`` closest to ``spp`` (``spp`` itself if
+    valid; ties go to fewer samples), or None if there is none for these
+    ``dims`` and ``strength``. Used wherever a requested count is replaced by
+    a sampler's nearest one (``pyoa compare``, convergence studies, the qmc
+    engine's default)."""
+    # Unlike valid_spp, a strength the sampler cannot have means "none" here
+    # (convergence studies skip such a sampler instead of failing).
+    choices = _listing(get(name), spp, dims, strength)
+    return min((c.spp for c in choices), key=lambda n: (abs(n - spp), n)) if choices else None

@@ -1,0 +1,72 @@
+"""Host-side tables of the orthogonal arrays' table paths, shared by the backends.
+
+The table paths (NumPy's and the OpenCL kernels' ``generate_cells`` and
+vector path) split an OA value into what depends on the sample only (its cell
+``A_ij`` and sub-stratum index ``u``, :func:`cells`), on the (pixel,
+dimension) only (the column key and the permutation shifts,
+:func:`column_keys`, :func:`table_keys`), and one gather per value. Both are
+computed here, on the host, once per rectangle of a request
+(:meth:`pyoa.request.Request.rectangles`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .hashes import U32, block_seed, pixel_seed
+from .reference.hashes import STRATUM_KEY, SUBSTRATUM_KEY
+
+
+def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(A_ij, u)`` of sample positions ``[k0, k1)`` of request ``req`` in each
+    of its dimensions: two C-contiguous uint32 arrays of shape
+    ``(n_dims, k1 - k0)``.
+
+    A cell depends on the sample and the column only, not on the pixel, so the
+    table path computes it once per rectangle of pixels x samples and gathers
+    the pixel's permutations with it (both backends; the OpenCL kernel
+    ``generate_cells`` reads exactly these arrays, and the vector path of
+    :mod:`pyoa._opencl.vector` the same, padded), from the entry's NumPy
+    cell function (:meth:`pyoa.constructions._OA.cells`). ``u`` is 0 for the
+    ``centered`` offset, which has no sub-stratum.
+    """
+    prm = req.params
+    i = req.samples[k0:k1][None, :]
+    col = (req.dims % U32(prm.block_dims))[:, None]
+    aij, u = req.construction.cells(i, col, prm)
+    shape = (req.n_dims, k1 - k0)
+    aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
+    if req.offset == "centered":
+        return aij, np.zeros(shape, U32)
+    return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
+
+
+def column_keys(req, pix0: int, pix1: int) -> np.ndarray:
+    """:func:`column_key` of every (pixel, dimension) of pixels ``[pix0, pix1)``
+    of request ``req``, shape ``(pixels, n_dims)``.
+
+    The block seed is hashed once per pixel and distinct block, not per
+    (pixel, dimension): requests have few blocks and many dimensions per
+    block."""
+    dmax = req.params.block_dims
+    p = pixel_seed(req.seed, req.pixels[pix0:pix1])
+    if len(p) == 0 or req.n_dims == 0:
+        return np.empty((len(p), req.n_dims), dtype=U32)
+    blocks, which = np.unique(req.dims // U32(dmax), return_inverse=True)
+    seeds = np.stack([block_seed(p, b) for b in blocks], axis=1)  # (pixels, distinct blocks)
+    return seeds[:, which] * (req.dims % U32(dmax) + U32(1))
+
+
+def table_keys(req, pix0: int, pix1: int) -> np.ndarray:
+    """Per (pixel, dimension) of pixels ``[pix0, pix1)``: the column key ``q``
+    (:func:`column_keys`) and the final shifts ``q * STRATUM_KEY % s`` and
+    ``q * SUBSTRATUM_KEY % M`` of its two permutations, as a C-contiguous
+    uint32 array of shape ``(pixels, n_dims, 3)`` (the OpenCL ``tables``
+    kernel reads it)."""
+    prm = req.params
+    q = column_keys(req, pix0, pix1)
+    out = np.empty((*q.shape, 3), dtype=U32)
+    out[..., 0] = q
+    np.remainder(q * U32(STRATUM_KEY), U32(prm.s), out=out[..., 1])
+    np.remainder(q * U32(SUBSTRATUM_KEY), U32(prm.M), out=out[..., 2])
+    return out
