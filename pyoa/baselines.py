@@ -132,7 +132,8 @@ class Baseline(Construction):
 
     def test_cases(self):
         # one sample, a few, the largest count (its last sample), many dimensions
-        return [dict(spp=1, dims=1), dict(spp=12, dims=5), dict(spp=self.max_spp, dims=3),
+        few = 12 if self.counts == "any" else 16
+        return [dict(spp=1, dims=1), dict(spp=few, dims=5), dict(spp=self.max_spp, dims=3),
                 dict(spp=4, dims=min(self.max_dims, 600))]
 
 

@@ -34,6 +34,10 @@ from tests.helpers import PIXEL_KEY, U32_MAX, assert_same_bits, kernel_runner
 U32 = np.uint32
 F32 = np.float32
 
+#: The paper's six comparison samplers, which this deeper suite checks with
+#: shapes worked out independently of the catalogue (shape_of). Every
+#: registered sampler, these and later ones, also runs the catalogue-driven
+#: suite of tests/test_catalogue.py, which needs no list.
 NAMES = ["random", "jittered2d", "cmj2d", "sobol02", "halton", "sobol"]
 #: the samplers that take a jitter amount
 JITTERED = {"jittered2d", "cmj2d"}

@@ -64,6 +64,9 @@ def spp_of(name: str, s: int, t: int) -> int:
 
 @st.composite
 def configs(draw):
+    # the five constructions of the paper and its index-2 extensions, with
+    # parameters drawn per construction below; every registered sampler also
+    # runs the catalogue-driven suite of tests/test_catalogue.py
     name = draw(st.sampled_from(["bose", "bush", "cmjnd", *INDEX2]))
     if name == "addelman-kempthorne":
         # small q, any q (prime up to 2887, odd prime power up to 243), the largest of each kind
