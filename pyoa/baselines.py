@@ -1,24 +1,36 @@
-"""The catalogue of comparison samplers: the paper's baselines [1]_.
+"""The catalogue's comparison samplers: the paper's baselines [1]_ and pbrt-v4's.
 
 ``random``, the padded ``jittered2d``, ``cmj2d`` and ``sobol02``, and the
-high-dimensional ``halton`` and ``sobol``: their valid sample counts, their
-parameters and their kernel codes. Each is evaluated statelessly per
-(pixel, sample, dimension) like the OA samplers; the mathematics is in
-:mod:`pyoa.reference.baselines` and ``docs/samplers.md``.
+high-dimensional ``halton`` and ``sobol`` of the paper's tables; pbrt-v4's
+default ``zsobol`` [2]_ and the progressive multi-jittered ``pmj02`` [3]_:
+their valid sample counts, their parameters and their implementations. Each
+is evaluated statelessly per (pixel, sample, dimension) like the OA samplers;
+the mathematics is in :mod:`pyoa.reference.baselines`,
+:mod:`pyoa.reference.zsobol`, :mod:`pyoa.reference.pmj02` and
+``docs/samplers.md``.
 
 References
 ----------
 .. [1] W. Jarosz, A. Enayet, A. Kensler, C. Kilpatrick, P. Christensen,
    "Orthogonal Array Sampling for Monte Carlo Rendering", EGSR 2019, Table 1.
+.. [2] A. G. M. Ahmed, P. Wonka, "Screen-space blue-noise diffusion of Monte
+   Carlo sampling error via hierarchical ordering of pixels", SIGGRAPH Asia
+   2020; M. Pharr, W. Jakob, G. Humphreys, pbrt-v4, ``ZSobolSampler``.
+.. [3] P. Christensen, A. Kensler, C. Kilpatrick, "Progressive Multi-Jittered
+   Sample Sequences", EGSR 2018.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import numbers
 from collections.abc import Sequence
 
-from . import sequences
+from . import pmj02_tables, sequences
 from ._numpy import baselines as _numpy_baselines
+from ._numpy import pmj02 as _numpy_pmj02
+from ._numpy import zsobol as _numpy_zsobol
 from .catalogue_types import (
     MAX_DIMS,
     MAX_SPP,
@@ -30,6 +42,8 @@ from .catalogue_types import (
     register,
 )
 from .reference import baselines as _reference_baselines
+from .reference import pmj02 as _reference_pmj02
+from .reference import zsobol as _reference_zsobol
 
 
 class AllCounts(Sequence):
@@ -348,3 +362,107 @@ class Sobol(Baseline):
     def claims(self, params, offset):
         # every dimension a (0,1)-sequence; dimensions 0 and 1 a (0,2)-sequence
         return [Claim("net", n=params.M, prefixes=True, pairs=1), Claim("latin", n=params.M)]
+
+
+@register
+class ZSobol(Baseline):
+    """``zsobol``: pbrt-v4's default sampler (Ahmed and Wonka 2020).
+
+    ``spp = 2**k``; needs the image: ``resolution=(width, height)``, each at
+    most ``2**16``, pixels numbered row-major (``pixel = y * width + x``, as
+    pyoa's renderer numbers them). Every pixel takes its own consecutive block
+    of ``N`` indices of one Owen-scrambled (0,2)-sequence per pair of
+    dimensions, handed out along a Morton (Z) curve of the image whose base-4
+    digits are permuted by hashes of the digits above them: each pixel's
+    samples of each pair are a (0,k,2)-net, and neighbouring pixels' blocks
+    together form larger nets, so the per-pixel errors are negatively
+    correlated (blue noise in screen space). Pairs ``(2b, 2b+1)`` are
+    scrambled independently (padding). Math and the differences from pbrt:
+    :func:`pyoa.reference.zsobol.zsobol`.
+    """
+
+    name = "zsobol"
+    code = 11
+    counts = "pow2"
+    needs_resolution = True
+    reference = staticmethod(_reference_zsobol.zsobol)
+    numpy = staticmethod(_numpy_zsobol.zsobol)
+    kernel = "sample_zsobol(i, j, a, b, c, pixel, seed)"
+    description = ("pbrt-v4's Z-order Sobol (Ahmed-Wonka): N a power of two, blue-noise error across pixels; "
+                   "needs resolution=(width, height)")
+
+    def params(self, spp, dims):
+        return Params(s=2, strength=2, block_dims=2, M=spp, dims=dims or 0)
+
+    def with_resolution(self, params, resolution):
+        if resolution is None:
+            raise ValueError("zsobol needs the image: resolution=(width, height), each in [1, 65536] (its Z-order "
+                             "curve spans the image; pixels are numbered row-major, y * width + x)")
+        if isinstance(resolution, (str, bytes)) or not isinstance(resolution, Sequence) or len(resolution) != 2:
+            raise TypeError(f"resolution must be a pair (width, height) of ints, got {resolution!r}")
+        for what, v in zip(("width", "height"), resolution):
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+                raise TypeError(f"resolution {what} must be an int, got {type(v).__name__} {v!r}")
+            if not 1 <= int(v) <= 1 << _reference_zsobol.MAX_LOG2RES:
+                raise ValueError(f"resolution {what} must be in [1, {1 << _reference_zsobol.MAX_LOG2RES}], got {v}")
+        return dataclasses.replace(params, resolution=(int(resolution[0]), int(resolution[1])))
+
+    def pixel_count(self, params):
+        width, height = params.resolution
+        return width * height
+
+    def shape_args(self, params):
+        width, height = params.resolution
+        return (params.M.bit_length() - 1, _reference_zsobol.resolution_log2(width, height), width)
+
+    def seed_args(self, pixel_seed, seed, pixel):
+        return (pixel, seed)  # the Morton curve needs the pixel itself; the seed keys the pairs
+
+    def claims(self, params, offset):
+        return [Claim("net", n=params.M), Claim("latin", n=params.M)]
+
+    def test_cases(self):
+        # one pixel, a non-power-of-two image at an odd k, full HD, the largest image and count
+        return [dict(spp=1, dims=2, resolution=(1, 1)), dict(spp=32, dims=5, resolution=(5, 3)),
+                dict(spp=16, dims=4, resolution=(1920, 1080)), dict(spp=256, dims=3, resolution=(64, 64)),
+                dict(spp=MAX_SPP, dims=3, resolution=(65536, 65536))]
+
+
+@register
+class PMJ02(Baseline):
+    """``pmj02``: progressive multi-jittered (0,2) sequences (Christensen et al. 2018).
+
+    ``spp = 2**k`` up to ``2**16``. Each pair of dimensions reads one of 16
+    precomputed pmj02 sequences of ``2**16`` points (built once by pyoa's own
+    implementation of the paper's algorithm, cached: :mod:`pyoa.pmj02_tables`),
+    chosen per (pixel, pair) by a hash and digitally shifted (XOR) by
+    another: every power-of-two prefix of every pair is a (0,k,2)-net and each
+    coordinate of it is stratified into ``2**k`` intervals, so the first ``n``
+    samples of a pixel are as good as any ``n``. Samples are not reordered (the
+    sequence is progressive). Math: :func:`pyoa.reference.pmj02.pmj02`.
+    """
+
+    name = "pmj02"
+    code = 12
+    counts = "pow2"
+    max_spp = _reference_pmj02.POINTS
+    reference = staticmethod(_reference_pmj02.pmj02)
+    numpy = staticmethod(_numpy_pmj02.pmj02)
+    kernel = "sample_pmj02(i, j, p, table)"
+    description = (f"progressive multi-jittered (0,2) (Christensen et al.): N a power of two up to "
+                   f"2^{_reference_pmj02.POINTS_LOG2}, every power-of-two prefix a (0,2)-net")
+
+    def params(self, spp, dims):
+        return Params(s=2, strength=2, block_dims=2, M=spp, dims=dims or 0)
+
+    def shape_args(self, params):
+        return (params.M.bit_length() - 1,)
+
+    def constants(self, params):
+        return pmj02_tables.tables()
+
+    def constants_key(self, params):
+        return self.name  # one table for every count
+
+    def claims(self, params, offset):
+        return [Claim("net", n=params.M, prefixes=True), Claim("latin", n=params.M)]
