@@ -23,6 +23,7 @@ from .atomic import atomic_path, check_writable
 from .backends import BackendUnavailable, PyoaFallbackWarning
 from .catalogue import get
 from .catalogue_types import MAX_UINT32, check_int
+from .samplers import trial_options
 from .units import format_rate
 
 FORMATS = (".npy", ".csv")
@@ -90,8 +91,9 @@ def _pixel_range(args) -> range:
 def cmd_points(args) -> int:
     pixels = _pixel_range(args)
     check_out(args.out, FORMATS)
-    smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, offset=args.offset,
-                  jitter=args.jitter, strength=args.strength, backend=args.backend, device=args.device)
+    options = dict(offset=args.offset, jitter=args.jitter, strength=args.strength, backend=args.backend,
+                   device=args.device, resolution=tuple(args.resolution) if args.resolution else None)
+    smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, **trial_options(args.sampler, options))
     t0 = time.perf_counter()
     x = smp.generate(pixels=pixels, progress=not args.quiet)
     dt = time.perf_counter() - t0
@@ -201,6 +203,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jitter", type=float, default=1.0,
                    help="jitter amount in [0, 1] (OA samplers, jittered2d, cmj2d; default 1)")
     p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
+    p.add_argument("--resolution", type=int, nargs=2, metavar=("W", "H"), default=None,
+                   help="image size of a sampler that needs one (zsobol; pixels row-major, y*W + x); "
+                        "default 65536 65536")
     p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="default: automatic")
     p.add_argument("--device", default=None, help="OpenCL device selector (gpu, cpu, P:D, name)")
     p.add_argument("--out", default="points.npy", help="output file, .npy or .csv (default points.npy)")

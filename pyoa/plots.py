@@ -24,6 +24,7 @@ import numpy as np
 from .atomic import atomic_path, check_writable
 from .catalogue_types import MAX_UINT32, check_int
 from .samplers import sampler as make_sampler
+from .samplers import trial_options
 
 #: Largest number of dimensions in a projection matrix (D*(D-1)/2 panels).
 MAX_PLOT_DIMS = 16
@@ -94,7 +95,7 @@ def projections(name: str, *, spp: int, dims: int, seed: int = 0, pixel: int = 0
         raise ValueError(f"a projection matrix needs 2 <= dims <= {MAX_PLOT_DIMS}, got {dims}")
     pixel = check_int("pixel", pixel, 0, MAX_UINT32)
     _check_figure(out, size)
-    smp = make_sampler(name, spp=spp, dims=dims, seed=seed, **options)
+    smp = make_sampler(name, spp=spp, dims=dims, seed=seed, **trial_options(name, options))
     x = smp.generate(pixels=[pixel])[0]
     s = _strata(smp)
     plt, fig = _figure(size)
@@ -184,7 +185,7 @@ def spectrum(name: str, *, spp: int, dims: tuple[int, int] = (0, 1), trials: int
     trials = check_int("trials", trials, 1, 100000)
     freq = check_int("freq", freq, 4, 512)
     _check_figure(out, size)
-    smp = make_sampler(name, spp=spp, dims=max(i, j) + 1, seed=seed, **options)
+    smp = make_sampler(name, spp=spp, dims=max(i, j) + 1, seed=seed, **trial_options(name, options))
     x = smp.generate(pixels=range(trials), dims=[i, j])
     p = power_spectrum(x, freq)
     p[freq, freq] = 0.0  # DC: N, drawn as 0

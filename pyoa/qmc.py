@@ -21,7 +21,7 @@ from scipy.stats import qmc
 
 from . import catalogue
 from .catalogue_types import MAX_DIMS, MAX_UINT32
-from .samplers import ENV_MAX_BYTES, Sampler
+from .samplers import ENV_MAX_BYTES, Sampler, trial_options
 from .units import format_bytes
 
 __all__ = ["OrthogonalArray", "DEFAULT_SPP_TARGET"]
@@ -252,8 +252,8 @@ class OrthogonalArray(qmc.QMCEngine):
         self.pyoa_seed = _draw_seed(self.rng)
         # pyoa validates spp (naming the nearest valid counts), strength,
         # offset, jitter and backend.
-        self.pyoa_sampler = Sampler(name, spp=spp, dims=d, seed=self.pyoa_seed, offset=offset, jitter=jitter,
-                                    strength=strength, backend=backend, max_bytes=max_bytes)
+        self.pyoa_sampler = Sampler(name, spp=spp, dims=d, seed=self.pyoa_seed, **trial_options(name, dict(
+            offset=offset, jitter=jitter, strength=strength, backend=backend, max_bytes=max_bytes)))
         smp = self.pyoa_sampler
         self.sampler_name = smp.name
         self.spp = smp.spp

@@ -33,6 +33,22 @@ ENV_MAX_BYTES = "PYOA_MAX_BYTES"
 _UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
 
 
+#: The image given to a sampler that needs one (``zsobol``) where its pixels
+#: are only independent trials (the analyses, plots, the qmc engine, ``pyoa
+#: points`` without ``--resolution``): the largest, 65536 x 65536, so that
+#: every uint32 pixel index is one of its pixels (row-major).
+TRIAL_RESOLUTION = (1 << 16, 1 << 16)
+
+
+def trial_options(name: str, options: dict) -> dict:
+    """``options`` (keyword arguments of :func:`sampler`) with
+    ``resolution=TRIAL_RESOLUTION`` added for a sampler that needs an image
+    and was given none (:data:`TRIAL_RESOLUTION`)."""
+    if options.get("resolution") is None and catalogue.get(name).needs_resolution:
+        return {**options, "resolution": TRIAL_RESOLUTION}
+    return options
+
+
 def samplers() -> dict[str, str]:
     """The sampler names :func:`sampler` accepts, each with a one-line description."""
     return {name: c.description for name, c in catalogue.SAMPLERS.items()}

@@ -20,7 +20,14 @@ from dataclasses import dataclass
 
 from ..hostcpu import host_cpu
 from . import program
-from .device import ENV_DEVICE, DeviceInfo, NoUsableDevice, candidates, list_devices, select_device
+from .device import (
+    ENV_DEVICE,
+    DeviceInfo,
+    NoUsableDevice,
+    candidates,
+    list_devices,
+    select_device,
+)
 
 #: What to do when a device's LLVM is older than the CPU: a PoCL built on a
 #: newer LLVM (Debian's pocl-opencl-icd: PoCL 3.1 on LLVM 15, which works on

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import catalogue
 from ..catalogue_types import MAX_UINT32
 from ..samplers import ENV_MAX_BYTES, default_max_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
@@ -174,7 +175,11 @@ def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: 
     cam = scene.camera
     layout = Layout(max_depth=depth, mis=scene.mis, lens=cam.aperture > 0,
                     time=bool(np.any(np.asarray(cam.motion) != 0)), first=first)
-    smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend, max_bytes=limit)
+    # a sampler whose values depend on the image (zsobol) gets the film's
+    # size; pixels are numbered row-major, y * width + x, as render() does
+    image = {"resolution": (width, height)} if catalogue.get(sampler).needs_resolution else {}
+    smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend, max_bytes=limit,
+                       **image)
     nbytes = render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
     check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit)
     return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit)
