@@ -25,14 +25,17 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 
-from pyoa import analysis, cli  # noqa: E402
+from pyoa import analysis, catalogue, cli  # noqa: E402
 from pyoa.atomic import atomic_path  # noqa: E402
-from pyoa.plots import projections, spectrum  # noqa: E402
+from pyoa.plots import error_spectra, projections, spectrum  # noqa: E402
 
 OUT = REPO / "docs" / "results"
-#: The paper's line-up; spp 121 (128 for the power-of-two samplers).
-LINEUP = [("random", 121), ("jittered2d", 121), ("cmj2d", 121), ("sobol02", 128), ("bose", 121),
-          ("halton", 121), ("sobol", 128)]
+#: Bose and every comparison sampler of the catalogue (the paper's six, then
+#: pbrt-v4's zsobol and pmj02), at the count nearest 121 (128 for the
+#: power-of-two samplers).
+LINEUP = [(n, catalogue.nearest_spp(n, 121)) for n in ("bose", *catalogue.names("baseline"))]
+#: The padded 2D samplers, which stratify pairs of dimensions only.
+PADDED = ("jittered2d", "cmj2d", "sobol02", "zsobol", "pmj02")
 
 
 #: Convergence cases (integrand, dimensions): smooth and discontinuous, 2 to 10
@@ -162,6 +165,31 @@ def part_convergence(page: Page) -> dict:
     return slopes
 
 
+def part_error_spectra(page: Page) -> None:
+    page.part("Screen-space error: blue noise")
+    size, seeds = (32, 2) if page.quick else (64, 8)
+    page.add(f"Each pixel of a {size} x {size} image estimates the area of a disk (the `ball` integrand in 2D, "
+             "dimensions 0 and 1) with its own samples; the periodogram of the error image, averaged over "
+             f"{seeds} seeds and divided by the error variance, is flat at 1 when the pixels' errors are "
+             "independent. `zsobol` (Ahmed and Wonka 2020) orders the pixels along a scrambled Z curve so that "
+             "neighbouring pixels' samples together form larger nets: their errors cancel, the spectrum is "
+             "dark at low frequencies (blue noise), and a blur or a denoiser removes more of the error. The "
+             "other samplers randomize every pixel independently, so their error is white; per-pixel RMSE is "
+             "what the sampler's own stratification gives.", "",
+             "| sampler | spp | low-frequency power (1 <= |k| <= size/8) | per-pixel RMSE |", "|---|---:|---:|---:|")
+    shown = []
+    for spp in (16, 64):
+        for name, _ in LINEUP:
+            n = catalogue.nearest_spp(name, spp)
+            res = analysis.error_spectrum(name, spp=n, size=size, seeds=seeds)
+            page.add(f"| {name} | {n} | {res.low:.3f} | {res.rmse:.4g} |")
+            if spp == 16 and name in ("zsobol", "sobol02", "pmj02", "bose"):
+                shown.append(res)
+    out = OUT / "error-spectra.png"
+    error_spectra(shown, out=str(out), size=800 if page.quick else 1400)
+    page.add("", f"![screen-space error spectra]({rel(out)})", "")
+
+
 def part_renders(page: Page) -> None:
     page.part("Renders")
     size = 48 if page.quick else 128
@@ -184,7 +212,7 @@ def part_renders(page: Page) -> None:
             print(f"   reference {scene}: {time.perf_counter() - t:.0f} s", flush=True)
         stem = OUT / f"{scene}-121"
         argv = ["compare", scene, "--size", str(size), str(size), "--spp", "121", "--reference", str(ref),
-                "--out", str(stem), "-q"]
+                "--samplers", ",".join(n for n, _ in LINEUP), "--out", str(stem), "-q"]
         if crop and not page.quick:
             argv += ["--crop", *map(str, crop)]
         cli.main(argv)
@@ -199,14 +227,17 @@ def _verdict(stem: Path) -> str:
     with open(stem.with_suffix(".csv")) as fh:
         rows = {r["sampler"]: float(r["relmse"]) for r in csv.DictReader(fh)}
     best = min(rows, key=rows.get)
-    padded = min((n for n in ("jittered2d", "cmj2d", "sobol02") if n in rows), key=rows.get)
+    padded = min((n for n in PADDED if n in rows), key=rows.get)
     ratio = rows[padded] / rows["bose"]
     verdict = "less" if ratio > 1.05 else ("more" if ratio < 0.95 else "about the same")
     amount = f"{ratio:.2f}x " if verdict == "less" else (f"{1 / ratio:.2f}x " if verdict == "more" else "")
     than = "as" if verdict == "about the same" else "than"
     return (f"Whole image: the lowest error is {best}'s ({rows[best]:.4g}); Bose has {amount}{verdict} error "
             f"{than} the best padded sampler ({padded}, {rows[padded]:.4g}) and {rows['random'] / rows['bose']:.2f}x "
-            "less than random.")
+            "less than random." + "".join(
+                f" Bose against {n}: {rows[n] / rows['bose']:.2f}x "
+                f"({'Bose lower' if rows[n] > rows['bose'] else 'Bose higher'})." for n in ("zsobol", "pmj02")
+                if n in rows))
 
 
 def main(argv=None) -> int:
@@ -222,6 +253,7 @@ def main(argv=None) -> int:
     part_projections(page)
     part_spectra(page)
     slopes = part_convergence(page)
+    part_error_spectra(page)
     part_renders(page)
     total = time.perf_counter() - page.t0
     reused = (f" The render references of {', '.join(page.reused)} were reused from an earlier run "

@@ -22,14 +22,17 @@
 
 /* Value j of sample i (i < PMJ02_POINTS) of the point set with seed p;
  * table: the (PMJ02_SETS, PMJ02_POINTS, 2) uint array of
- * pyoa.pmj02_tables.tables(), flat. The pair b = j >> 1 reads set h >> 28,
- * digitally shifted (XOR of the 24-bit fraction: elementary intervals map
- * onto elementary intervals); p == 0 reads set 0 unshifted. */
+ * pyoa.pmj02_tables.tables(), flat. The pair b = j >> 1 reads set h >> 28
+ * in its own nested-scrambled order (prefixes map onto aligned blocks, which
+ * are nets), digitally shifted (XOR of the 24-bit fraction: elementary
+ * intervals map onto elementary intervals); p == 0 reads set 0 unshifted in
+ * its own order. */
 float sample_pmj02(uint i, uint j, uint p, __global const uint *table)
 {
     uint c = j & 1u;
     uint h = derived_seed(p, j >> 1, PMJ02_KEY);
     uint shift = derived_seed(h, 1u + c, PMJ02_SHIFT_KEY) >> 8;
-    uint k = table[((h >> 28) * PMJ02_POINTS + i) * 2u + c];
+    uint g = owen_scramble(i, derived_seed(h, 0u, PMJ02_SHIFT_KEY)) & (PMJ02_POINTS - 1u);
+    uint k = table[((h >> 28) * PMJ02_POINTS + g) * 2u + c];
     return convert_float(k ^ shift) * 0x1.0p-24f;
 }

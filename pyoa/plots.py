@@ -205,3 +205,38 @@ def spectrum(name: str, *, spp: int, dims: tuple[int, int] = (0, 1), trials: int
         fig.tight_layout()
     _save(plt, fig, out)
     return p, radii, mean
+
+
+def error_spectra(results, *, out: str, size: int = 1200) -> None:
+    """One figure of screen-space error spectra (:func:`pyoa.analysis.error_spectrum`):
+    for each result its normalized periodogram (white noise = 1, a dark centre
+    is blue noise), then all radial means on one plot.
+
+    ``results`` is a sequence of :class:`pyoa.analysis.ErrorSpectrum`; ``out``
+    must end in .png (written atomically).
+    """
+    results = list(results)
+    if not results:
+        raise ValueError("error_spectra needs at least one ErrorSpectrum")
+    _check_figure(out, size)
+    n = len(results)
+    plt, fig = _figure(size, size * 2 // (n + 1) + 60)
+    for k, res in enumerate(results):
+        ax = fig.add_subplot(1, n + 1, k + 1)
+        c = res.size // 2
+        ax.imshow(res.power, extent=(-c, res.size - c, -c, res.size - c), origin="lower", cmap="gray", vmin=0,
+                  vmax=2)
+        ax.set_title(f"{res.sampler}, {res.spp} spp\nlow-freq. power {res.low:.2f}", fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    ax = fig.add_subplot(1, n + 1, n + 1)
+    for res in results:
+        ax.plot(res.radii, res.radial, lw=1, label=res.sampler)
+    ax.axhline(1.0, color="0.6", lw=0.5)
+    ax.set_xlabel("frequency |k| (cycles per image)", fontsize=8)
+    ax.set_ylabel("radial mean power", fontsize=8)
+    ax.legend(fontsize=7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        fig.tight_layout()
+    _save(plt, fig, out)

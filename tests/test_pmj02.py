@@ -401,17 +401,28 @@ def test_unrandomized_is_set_zero_in_order(table):
         assert_same_bits(got, (table[0, :, j & 1] * 2.0**-24).astype(F32), f"j={j}")
 
 
-def test_values_are_the_shifted_table_in_order(table):
-    """For p != 0: set h >> 28, XOR by one 24-bit constant per coordinate, index
-    not shuffled."""
+def test_values_are_the_shifted_table_in_a_nested_order(table):
+    """For p != 0: set h >> 28 read in a nested-scrambled order that does not
+    depend on N (every prefix of 2^k samples is an aligned block of the set),
+    XOR by one 24-bit constant per coordinate; the pairs of one pixel read
+    their sets in different orders (padding)."""
+    from pyoa.reference.baselines import owen_scramble
+
     p = 0x9E3779B9
+    orders = []
     for b in (0, 1, 77):
         h = hash_pair(p, b, R.PMJ02_KEY)
+        g = np.array([owen_scramble(i, hash_pair(h, 0, R.PMJ02_SHIFT_KEY)) & 0xFFFF for i in range(2**16)])
+        assert sorted(g) == list(range(2**16))  # a permutation of the set
+        for k in (1, 4, 9, 16):  # every prefix an aligned block
+            assert g[: 1 << k].max() - g[: 1 << k].min() == (1 << k) - 1 and g[0] >> k == g[(1 << k) - 1] >> k
+        orders.append(g)
         for c in (0, 1):
             k = as_ints(npmj.pmj02(np.arange(2**16, dtype=U32), U32(2 * b + c), 16, U32(p)))
-            shift = k ^ table[h >> 28, :, c].astype(np.int64)
+            shift = k ^ table[h >> 28, g, c].astype(np.int64)
             assert np.all(shift == shift[0])
             assert shift[0] == hash_pair(h, 1 + c, R.PMJ02_SHIFT_KEY) >> 8
+    assert not np.array_equal(orders[0], orders[1])
 
 
 def test_every_pixel_prefix_is_a_net(table):

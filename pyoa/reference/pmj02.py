@@ -106,7 +106,7 @@ References
 
 from __future__ import annotations
 
-from .baselines import UNIT24, derived_seed
+from .baselines import UNIT24, derived_seed, owen_scramble
 from .hashes import MASK, hash_pair
 
 #: Key of the per-pair seed ``h`` (it picks the set and seeds the shifts).
@@ -281,11 +281,19 @@ def pmj02(i: int, j: int, log2n: int, p: int) -> float:
     :func:`pyoa.pmj02_tables.tables`::
 
         h = derived_seed(p, b, PMJ02_KEY)
-        x = (T[h >> 28, i, c] ^ (derived_seed(h, 1 + c, PMJ02_SHIFT_KEY) >> 8)) * 2**-24
+        g = owen_scramble(i, derived_seed(h, 0, PMJ02_SHIFT_KEY)) mod 2**16
+        x = (T[h >> 28, g, c] ^ (derived_seed(h, 1 + c, PMJ02_SHIFT_KEY) >> 8)) * 2**-24
 
     For every ``p`` and pair, the first ``2**k`` samples (``k <= 16``) are a
-    (0,k,2)-net: one point in each elementary interval of area ``2**-k``
-    (the digital shift maps intervals onto intervals; module docstring).
+    (0,k,2)-net: one point in each elementary interval of area ``2**-k``.
+    The nested (Owen) scramble of the index maps the prefix ``[0, 2**k)``
+    onto an aligned block ``[c 2**k, (c+1) 2**k)`` of the set, which is a
+    (0,k,2)-net (every aligned block of the balanced construction is one,
+    module docstring), whatever ``N``: the sequence stays progressive. It
+    also gives each pair its own sample order, so that pairs of one pixel are
+    independent (padding, as ``sobol02``): without it, sample ``i`` of every
+    set sits in the same subquadrant pattern and the pairs' strata would be
+    correlated. The digital shift maps intervals onto intervals.
 
     Parameters
     ----------
@@ -315,5 +323,6 @@ def pmj02(i: int, j: int, log2n: int, p: int) -> float:
 
     c = j & 1
     h = derived_seed(p, j >> 1, PMJ02_KEY)
+    g = owen_scramble(i, derived_seed(h, 0, PMJ02_SHIFT_KEY)) & (POINTS - 1)
     shift = derived_seed(h, 1 + c, PMJ02_SHIFT_KEY) >> 8
-    return (int(tables()[h >> 28, i, c]) ^ shift) * UNIT24
+    return (int(tables()[h >> 28, g, c]) ^ shift) * UNIT24

@@ -395,8 +395,8 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser("compare", help="render with several samplers and tabulate relMSE against a reference")
     common(p, 121)
-    p.add_argument("--samplers", default="random,jittered2d,cmj2d,sobol02,bose,halton,sobol",
-                   help="comma-separated sampler names")
+    p.add_argument("--samplers", default=",".join(["bose", *catalogue.names("baseline")]),
+                   help="comma-separated sampler names (default: bose and every comparison sampler)")
     p.add_argument("--reference", required=True, help="reference EXR (pyoa reference SCENE)")
     p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
                    help="crop window (default: the quarter-size window at (W/4, H/4))")
