@@ -40,8 +40,8 @@ machine. ``--quick`` scales the pixel count down (to 4,096) for a smoke run
 of a few seconds; such results are marked ``quick`` and are not comparable
 with a full run. ``--cases all`` adds every other case (each OA
 construction and offset, and the comparison samplers); that takes about 15
-minutes, so they are opt-in. ``--cases baselines`` runs the six comparison
-samplers (about 6 minutes with the default case).
+minutes, so they are opt-in. ``--cases baselines`` runs every comparison sampler of the catalogue
+(about 8 minutes with the default case).
 
 Peers
 -----
@@ -112,6 +112,8 @@ import numpy as np
 
 try:
     import pyoa
+    from pyoa import catalogue
+    from pyoa.samplers import trial_options
 except ImportError as _exc:  # pragma: no cover - environment problem
     sys.exit(f"bench_generate: cannot import pyoa ({_exc}); install it first: pip install -e .")
 
@@ -148,20 +150,14 @@ CASES: dict[str, dict] = {
                          about="Addelman-Kempthorne q=7 (index 2), correlated multi-jittered offsets"),
     "bosebush-cmj-128x10": dict(name="bose-bush", spp=128, dims=10, offset="cmj", strength=None,
                                 about="Bose-Bush s=8 in GF(16) (index 2), correlated multi-jittered offsets"),
-    # The paper's comparison samplers, at the same or the nearest valid count.
-    "random-121x10": dict(name="random", spp=121, dims=10, offset=None, strength=None,
-                          about="independent uniform random values"),
-    "jittered2d-121x10": dict(name="jittered2d", spp=121, dims=10, offset=None, strength=None,
-                              about="padded 2D jittered, 11 x 11 per pair"),
-    "cmj2d-121x10": dict(name="cmj2d", spp=121, dims=10, offset=None, strength=None,
-                         about="padded 2D correlated multi-jittered (Kensler), 11 x 11 per pair"),
-    "sobol02-128x10": dict(name="sobol02", spp=128, dims=10, offset=None, strength=None,
-                           about="padded (0,2)-sequence, Owen-scrambled, 2^7"),
-    "halton-121x10": dict(name="halton", spp=121, dims=10, offset=None, strength=None,
-                          about="Owen-scrambled Halton, bases 2..29"),
-    "sobol-128x10": dict(name="sobol", spp=128, dims=10, offset=None, strength=None,
-                         about="Owen-scrambled Sobol (Joe-Kuo), 2^7"),
 }
+# Every comparison sampler of the catalogue (the paper's six, pbrt-v4's zsobol
+# and pmj02), at the count nearest 121, 10 dimensions.
+CASES.update({
+    f"{n}-{catalogue.nearest_spp(n, 121)}x10": dict(name=n, spp=catalogue.nearest_spp(n, 121), dims=10, offset=None,
+                                                    strength=None, about=catalogue.get(n).description)
+    for n in catalogue.names("baseline")
+})
 #: The comparison samplers' cases (``--cases baselines``).
 BASELINE_CASES = tuple(c for c, spec in CASES.items() if spec["offset"] is None)
 REQUIRED_CASE = "bose-cmj-121x10"
@@ -252,8 +248,10 @@ def prepare(case: str, backend: str, pixels: int, seed: int, fresh: bool = False
         t0 = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("error", pyoa.PyoaFallbackWarning)  # never a silent fallback
-            smp = _Fill((pixels, spec["spp"], spec["dims"])) if name == "fill" else pyoa.sampler(spec["name"], spp=spec["spp"], dims=spec["dims"], seed=seed,
-                               offset=spec["offset"], strength=spec["strength"], backend=name, device=device)
+            smp = _Fill((pixels, spec["spp"], spec["dims"])) if name == "fill" else pyoa.sampler(
+                spec["name"], spp=spec["spp"], dims=spec["dims"], seed=seed,
+                **trial_options(spec["name"], dict(offset=spec["offset"], strength=spec["strength"], backend=name,
+                                                   device=device)))
         entry["setup_s"] = time.perf_counter() - t0
     except Exception as exc:  # noqa: BLE001 - an unusable backend is reported, not fatal
         _fail(entry, "skipped", exc)

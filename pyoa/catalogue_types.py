@@ -275,9 +275,10 @@ class Construction:
         the samplers that do not use it (they refuse one), required by those
         that do (:attr:`needs_resolution`)."""
         if resolution is not None:
-            needing = ", ".join(c.name for c in REGISTRY.values() if c.needs_resolution)
-            raise ValueError(f"{self.name} takes no resolution (got resolution={resolution!r}); "
-                             f"only {needing} depend on where a pixel lies in the image")
+            needing = [c.name for c in REGISTRY.values() if c.needs_resolution]
+            raise ValueError(f"{self.name} takes no resolution (got resolution={resolution!r}); only "
+                             f"{', '.join(needing)} {'depends' if len(needing) == 1 else 'depend'} on where a "
+                             "pixel lies in the image")
         return params
 
     def pixel_count(self, params: Params) -> int:
