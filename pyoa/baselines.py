@@ -438,8 +438,10 @@ class PMJ02(Baseline):
     chosen per (pixel, pair) by a hash and digitally shifted (XOR) by
     another: every power-of-two prefix of every pair is a (0,k,2)-net and each
     coordinate of it is stratified into ``2**k`` intervals, so the first ``n``
-    samples of a pixel are as good as any ``n``. Samples are not reordered (the
-    sequence is progressive). Math: :func:`pyoa.reference.pmj02.pmj02`.
+    samples of a pixel are as good as any ``n``. Each pair reads its set in
+    its own nested-scrambled order, which maps every prefix onto an aligned
+    block of the set (a net too), so pairs are independent and the sequence
+    stays progressive. Math: :func:`pyoa.reference.pmj02.pmj02`.
     """
 
     name = "pmj02"

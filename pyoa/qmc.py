@@ -82,13 +82,15 @@ class OrthogonalArray(qmc.QMCEngine):
         valid ones. Default: the valid count nearest to 121 (ties towards
         fewer), given `d` and `strength`: 121 (s = 11) for ``bose``, ``bush``
         and ``cmjnd``, 98 for ``addelman-kempthorne``, 128 for ``bose-bush``,
-        ``sobol`` and ``sobol02``.
+        ``sobol``, ``sobol02``, ``zsobol`` and ``pmj02``.
     sampler : str, optional
         A pyoa sampler name (see :func:`pyoa.samplers`): an orthogonal array
         (``"bose"``, the default; ``"bush"``, ``"cmjnd"``,
         ``"addelman-kempthorne"``, ``"bose-bush"``) or a comparison sampler
         (``"random"``, ``"jittered2d"``, ``"cmj2d"``, ``"sobol02"``,
-        ``"halton"``, ``"sobol"``).
+        ``"halton"``, ``"sobol"``, ``"zsobol"``, ``"pmj02"``). ``zsobol``
+        needs an image: the engine's arrays are pixels ``0, 1, ...`` of
+        :data:`pyoa.samplers.TRIAL_RESOLUTION` (65536 x 65536, row-major).
     strength : int, optional
         ``bush`` and ``cmjnd`` only: the strength t, with ``spp = s**t``.
         Default: pyoa's (the largest ``t <= d`` for which `spp` is a t-th power).

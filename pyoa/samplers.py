@@ -256,9 +256,12 @@ class Sampler:
     """A sampler: ``x(pixel, i, j)`` for every pixel, sample and dimension.
 
     Orthogonal-array samplers (``bose``, ``bush``, ``cmjnd``,
-    ``addelman-kempthorne``, ``bose-bush``) and the paper's comparison
+    ``addelman-kempthorne``, ``bose-bush``), the paper's comparison
     samplers (``random``, ``jittered2d``, ``cmj2d``, ``sobol02``, ``halton``,
-    ``sobol``) share this class, its API and its bit-exactness guarantees.
+    ``sobol``) and pbrt-v4's ``zsobol`` (Z-order Sobol, blue-noise error
+    across pixels; needs ``resolution``) and ``pmj02`` (progressive
+    multi-jittered (0,2)) share this class, its API and its bit-exactness
+    guarantees.
 
     Create one with :func:`sampler`. Immutable (setting or deleting an
     attribute raises AttributeError: make a new sampler instead) and safe to
@@ -550,7 +553,11 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         block), ``"addelman-kempthorne"``, ``"bose-bush"`` (``spp = 2 s**2``).
         Comparison samplers: ``"random"``, ``"jittered2d"``, ``"cmj2d"``,
         ``"sobol02"`` (padded pairs), ``"halton"`` and ``"sobol"``
-        (high-dimensional, Owen-scrambled). See :func:`samplers`,
+        (high-dimensional, Owen-scrambled), and pbrt-v4's ``"zsobol"``
+        (``spp = 2**k``; every pixel's samples of a pair a (0,k,2)-net,
+        blue-noise error across the image; needs `resolution`) and
+        ``"pmj02"`` (progressive multi-jittered (0,2), ``spp = 2**k`` up to
+        ``2**16``, from a table built once and cached). See :func:`samplers`,
         :func:`valid_spp` and ``docs/samplers.md``.
     spp : int
         Samples per pixel. An invalid count raises a ValueError naming the

@@ -29,10 +29,14 @@ that moves interval boundaries, so a rotated (0,k,2)-net in general has two
 points in some elementary intervals and none in others; the rotation keeps
 only the coarse jittered structure.
 
-**No index shuffle.** Sample ``i`` is point ``i`` of the sequence: pmj02
-is progressive, the first ``n`` samples of a pixel are the best ``n``
-(pbrt-v4 shuffles the index within the pixel's sample count, which keeps the
-full set but not its prefixes). ``log2n`` only bounds ``i``.
+**A nested index scramble over the whole sequence.** Sample ``i`` is point
+``g = owen_scramble(i, ...) mod 2**16`` of the set: every prefix
+``[0, 2**k)`` of the samples maps onto an aligned block of ``2**k`` points,
+which is a (0,k,2)-net, whatever ``N``, so pmj02 stays progressive (the
+first ``n`` samples of a pixel are as good as any ``n``), and each pair of
+a pixel reads its set in its own order, so pairs are independent (padding).
+pbrt-v4 shuffles the index within the pixel's sample count, which keeps the
+full set but not its prefixes. ``log2n`` only bounds ``i``.
 
 The table builder
 -----------------
