@@ -267,8 +267,12 @@ def test_addelman_kempthorne_kernel_constants_layout():
 
 def test_samplers_listing():
     names = pyoa.samplers()
-    assert set(names) == {"bose", "bush", "cmjnd", "addelman-kempthorne", "bose-bush",
-                          "random", "jittered2d", "cmj2d", "sobol02", "halton", "sobol"}
+    from pyoa import catalogue
+
+    # every registered sampler, OA constructions first, with its description
+    assert list(names) == list(catalogue.SAMPLERS)
+    assert names == {n: c.description for n, c in catalogue.SAMPLERS.items()}
+    assert {"bose", "bush", "cmjnd", "random", "sobol"} <= set(names)
     assert all(isinstance(v, str) and v for v in names.values())
 
 

@@ -145,11 +145,14 @@ def test_kernel_keys_are_build_defines_of_the_python_constants():
         defined = re.findall(r"^\s*#\s*define\s+(\w*_KEY)\b", text, re.MULTILINE)
         assert not defined, f"kernels/{path.name} defines {defined}: keys come from program.defines() only"
     source = program.source()
-    assert set(re.findall(r"\b[A-Z][A-Z0-9_]*_KEY\b", source)) == set(want)
-    assert set(re.findall(r"^\s*#\s*ifndef\s+(\w+_KEY)\s*$", source, re.MULTILINE)) == set(want)
+    # every key a kernel names is a define and guarded; a reference key no
+    # kernel uses (pmj02's table-builder keys) is passed but need not appear
+    used = set(re.findall(r"\b[A-Z][A-Z0-9_]*_KEY\b", source))
+    assert used <= set(want) and {"PIXEL_KEY", "OWEN_KEY", "ZSOBOL_KEY", "PMJ02_KEY"} <= used
+    assert set(re.findall(r"^\s*#\s*ifndef\s+(\w+_KEY)\s*$", source, re.MULTILINE)) == used
 
 
-@pytest.mark.parametrize("key", sorted(KERNEL_KEYS))
+@pytest.mark.parametrize("key", sorted(k for k in KERNEL_KEYS if k not in ("PMJ02_BUILD_KEY", "PMJ02_DRAW_KEY")))
 def test_program_without_a_key_define_does_not_build(monkeypatch, opencl, key):
     """A key missing from the build options stops the build with an #error naming it."""
     from pyoa._opencl import program
