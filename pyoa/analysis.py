@@ -1086,6 +1086,23 @@ def convergence(samplers, integrand, d: int, spp_targets, *, trials: int = 64, s
 
 # ============================================================================ screen-space error spectra
 
+def radial_mean(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean of a centred square spectrum (DC at index ``n // 2`` of each axis,
+    as ``np.fft.fftshift`` and :func:`pyoa.plots.power_spectrum` lay it out)
+    over rings ``r <= |k| < r + 1`` up to ``n // 2``; DC excluded. Returns
+    ``(radii, means)`` of the non-empty rings."""
+    n = p.shape[0]
+    c = n // 2
+    ky, kx = np.mgrid[-c:n - c, -c:n - c]
+    r = np.hypot(kx, ky)
+    ring = np.floor(r).astype(int)
+    keep = (r > 0) & (ring <= c)
+    sums = np.bincount(ring[keep], weights=p[keep], minlength=c + 1)
+    counts = np.bincount(ring[keep], minlength=c + 1)
+    ok = counts > 0
+    return np.arange(c + 1)[ok], sums[ok] / counts[ok]
+
+
 @dataclass(frozen=True)
 class ErrorSpectrum:
     """The screen-space power spectrum of per-pixel integration error
@@ -1194,13 +1211,9 @@ def error_spectrum(sampler: str, *, spp: int, size: int = 64, seeds: int = 8, in
     c = size // 2
     power[c, c] = 0.0  # DC: the mean error, not its distribution
     power /= power.sum() / (size * size - 1)  # white noise: 1 everywhere
+    radii, radial = radial_mean(power)
     ky, kx = np.mgrid[-c:size - c, -c:size - c]
     r = np.hypot(kx, ky)
-    ring = np.floor(r).astype(int)
-    keep = (r > 0) & (ring <= c)
-    counts = np.bincount(ring[keep], minlength=c + 1)
-    radii = np.arange(c + 1)[counts > 0]
-    radial = (np.bincount(ring[keep], weights=power[keep], minlength=c + 1) / np.maximum(counts, 1))[counts > 0]
     low = float(power[(r >= 1) & (r <= size / 8)].mean())
     return ErrorSpectrum(sampler=pyoa.catalogue.get(sampler).name, integrand=f.name, spp=smp.spp, size=size,
                          seeds=seeds, power=power, radii=radii, radial=radial, low=low,

@@ -21,6 +21,7 @@ import warnings
 
 import numpy as np
 
+from .analysis import radial_mean  # noqa: F401  (pyoa.plots.radial_mean, as before)
 from .atomic import atomic_path, check_writable
 from .catalogue_types import MAX_UINT32, check_int
 from .samplers import sampler as make_sampler
@@ -145,20 +146,6 @@ def power_spectrum(x: np.ndarray, freq: int) -> np.ndarray:
         ey = np.exp(-2j * np.pi * np.outer(k, pts[:, 1]))
         acc += np.abs(ey @ ex.T) ** 2
     return acc / (len(x) * x.shape[1])
-
-
-def radial_mean(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Mean of a centred spectrum over rings ``r <= |k| < r + 1``; DC excluded."""
-    freq = (p.shape[0] - 1) // 2
-    ky, kx = np.mgrid[-freq:freq + 1, -freq:freq + 1]
-    r = np.hypot(kx, ky)
-    ring = np.floor(r).astype(int)
-    keep = (r > 0) & (ring <= freq)
-    sums = np.bincount(ring[keep], weights=p[keep], minlength=freq + 1)
-    counts = np.bincount(ring[keep], minlength=freq + 1)
-    radii = np.arange(freq + 1)
-    ok = counts > 0
-    return radii[ok], sums[ok] / counts[ok]
 
 
 def spectrum(name: str, *, spp: int, dims: tuple[int, int] = (0, 1), trials: int = 64, seed: int = 0,

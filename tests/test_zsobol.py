@@ -434,6 +434,15 @@ def test_kernel_equals_numpy(harness):
     dimensions up to 2^32 - 1."""
     cols = {n: [] for n in ("i", "j", "log2n", "log2res", "width", "pixel", "seed")}
     want, want_g = [], []
+
+    def add(i, j, px, k, lr, W, seed):
+        """One batch of kernel arguments and the values NumPy gives for it."""
+        for name, v in (("i", i), ("j", j), ("pixel", px)):
+            cols[name].append(v.astype(U32))
+        for name, v in (("log2n", k), ("log2res", lr), ("width", W), ("seed", seed)):
+            cols[name].append(np.full(len(i), v, dtype=U32))
+        want.append(nz.zsobol(i, j, k, lr, W, px, seed))
+        want_g.append((nz.sample_index(i, j >> 1, k, lr, W, px, seed) & np.uint64(U32_MAX)).astype(U32))
     for W, H, k, seed in KERNEL_CONFIGS:
         rng = np.random.default_rng(zlib.crc32(repr((W, H, k, seed)).encode()))
         n, N, P = 256, 1 << k, W * H
@@ -443,12 +452,7 @@ def test_kernel_equals_numpy(harness):
         j[: n // 2] %= 8
         i[:2], px[:2], j[:4] = [0, N - 1], [0, P - 1], [0, 1, U32_MAX - 1, U32_MAX]
         lr = rz.resolution_log2(W, H)
-        for name, v in (("i", i), ("j", j), ("pixel", px)):
-            cols[name].append(v.astype(U32))
-        for name, v in (("log2n", k), ("log2res", lr), ("width", W), ("seed", seed)):
-            cols[name].append(np.full(n, v, dtype=U32))
-        want.append(nz.zsobol(i, j, k, lr, W, px, seed))
-        want_g.append((nz.sample_index(i, j >> 1, k, lr, W, px, seed) & np.uint64(U32_MAX)).astype(U32))
+        add(i, j, px, k, lr, W, seed)
     # pixels beyond the image, any uint32 (rows taken modulo 2^16)
     for W, H, k, seed in [(7, 1, 6, 11), (MAX_SIDE, MAX_SIDE, 24, 3), (1, 1, 0, 0)]:
         rng = np.random.default_rng(W + k)
@@ -457,12 +461,7 @@ def test_kernel_equals_numpy(harness):
         px = rng.integers(0, 2**32, n, dtype=np.int64)
         j = rng.integers(0, 16, n, dtype=np.int64)
         px[0] = U32_MAX
-        for name, v in (("i", i), ("j", j), ("pixel", px)):
-            cols[name].append(v.astype(U32))
-        for name, v in (("log2n", k), ("log2res", lr), ("width", W), ("seed", seed)):
-            cols[name].append(np.full(n, v, dtype=U32))
-        want.append(nz.zsobol(i, j, k, lr, W, px, seed))
-        want_g.append((nz.sample_index(i, j >> 1, k, lr, W, px, seed) & np.uint64(U32_MAX)).astype(U32))
+        add(i, j, px, k, lr, W, seed)
     args = [np.concatenate(cols[n]) for n in ("i", "j", "log2n", "log2res", "width", "pixel", "seed")]
     got, got_g = harness("tz_sample", [F32, U32], *args)
     assert np.array_equal(got_g, np.concatenate(want_g))

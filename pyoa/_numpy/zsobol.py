@@ -14,10 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import sequences
 from ..reference.baselines import OWEN_KEY
 from ..reference.zsobol import DIGIT_MULT, PERMS, ZSOBOL_KEY, digit_count
-from .baselines import owen_scramble, reverse_bits, unit24
+from .baselines import owen_scramble, sobol_bits, unit24
 from .hashes import U32, hash_pair
 
 U64 = np.uint64
@@ -93,23 +92,6 @@ def permute_digits(m, q, log2n: int, log2res: int, bits: int = 64) -> np.ndarray
     return g
 
 
-def sobol_bits01(g, c) -> np.ndarray:
-    """:func:`pyoa.reference.baselines.sobol_bits` of Sobol' dimension ``c``
-    (0 or 1) for uint32 indices ``g``: dimension 0's direction numbers are
-    ``2**(31-k)`` (a bit reversal), dimension 1's are taken from
-    :func:`pyoa.sequences.sobol_matrices` and XORed in with masks (no
-    per-bit ``where`` over the whole table, as the general sobol_bits)."""
-    g, c = np.broadcast_arrays(np.asarray(g, dtype=U32), np.asarray(c, dtype=U32))
-    x0 = reverse_bits(g)
-    if not np.any(c):
-        return x0
-    V1 = sequences.sobol_matrices()[1]
-    x1 = np.zeros(g.shape, dtype=U32)
-    for k in range(32):
-        x1 ^= V1[k] & (U32(0) - ((g >> U32(k)) & U32(1)))
-    return np.where(c == 0, x0, x1)
-
-
 def sample_index(i, b, log2n: int, log2res: int, width: int, pixel, seed: int) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.zsobol.sample_index`: the whole permuted
     index ``g`` (uint64, at least 1-d, the broadcast shape of ``i``, ``b``
@@ -127,4 +109,4 @@ def zsobol(i, j, log2n: int, log2res: int, width: int, pixel, seed: int) -> np.n
     c = j & U32(1)
     q = hash_pair(U32(seed), j >> U32(1), ZSOBOL_KEY)
     g = permute_digits(morton_index(i, log2n, width, pixel), q, log2n, log2res, bits=32).astype(U32)
-    return unit24(owen_scramble(sobol_bits01(g, c), hash_pair(q, U32(1) + c, OWEN_KEY)))
+    return unit24(owen_scramble(sobol_bits(g, c), hash_pair(q, U32(1) + c, OWEN_KEY)))
