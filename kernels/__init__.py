@@ -7,7 +7,7 @@
 """
 
 #: The kernel sources in dependency order.
-SOURCES = ("hashes.cl", "floats.cl", "gf.cl", "oa.cl", "baselines.cl", "zsobol.cl", "pmj02.cl", "generate.cl")
+SOURCES = ("hashes.cl", "floats.cl", "gf.cl", "oa.cl", "baselines.cl", "zsobol.cl", "pmj02.cl", "faure.cl", "generate.cl")
 #: The vector path's program (pyoa._opencl.vector): built per request shape,
 #: with that shape's constants as defines.
 VECTOR_SOURCES = ("hashes.cl", "floats.cl", "baselines.cl", "vector.cl")

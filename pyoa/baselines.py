@@ -165,6 +165,8 @@ class Random(Baseline):
 
     name = "random"
     code = 5
+    progressive = True
+    spp_invariant = True
     reference = staticmethod(_reference_baselines.random)
     numpy = staticmethod(_numpy_baselines.random)
     kernel = "sample_random(i, j, p)"
@@ -280,6 +282,7 @@ class Sobol02(Baseline):
 
     name = "sobol02"
     code = 8
+    progressive = True
     counts = "pow2"
     reference = staticmethod(_reference_baselines.sobol02)
     numpy = staticmethod(_numpy_baselines.sobol02)
@@ -316,6 +319,8 @@ class Halton(Baseline):
 
     name = "halton"
     code = 9
+    progressive = True
+    spp_invariant = True
     reference = staticmethod(_reference_baselines.halton)
     numpy = staticmethod(_numpy_baselines.halton)
     kernel = "sample_halton(i, j, p, table)"
@@ -346,6 +351,8 @@ class Sobol(Baseline):
 
     name = "sobol"
     code = 10
+    progressive = True
+    spp_invariant = True
     counts = "pow2"
     reference = staticmethod(_reference_baselines.sobol)
     numpy = staticmethod(_numpy_baselines.sobol)
@@ -383,6 +390,7 @@ class ZSobol(Baseline):
 
     name = "zsobol"
     code = 11
+    progressive = True
     counts = "pow2"
     needs_resolution = True
     reference = staticmethod(_reference_zsobol.zsobol)
@@ -446,6 +454,7 @@ class PMJ02(Baseline):
 
     name = "pmj02"
     code = 12
+    progressive = True
     counts = "pow2"
     max_spp = _reference_pmj02.POINTS
     reference = staticmethod(_reference_pmj02.pmj02)

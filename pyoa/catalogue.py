@@ -2,7 +2,8 @@
 
 :data:`SAMPLERS` maps each name to its entry (:mod:`pyoa.catalogue_types`):
 the orthogonal-array constructions of :mod:`pyoa.constructions`, then the
-comparison samplers of :mod:`pyoa.baselines`. Everything that lists, looks
+comparison samplers of :mod:`pyoa.baselines` and the progressive orthogonal
+arrays of :mod:`pyoa.progressive`. Everything that lists, looks
 up or dispatches samplers reads it: :func:`pyoa.samplers`, the backends, the
 kernel dispatch (:func:`pyoa._opencl.program.dispatch_source`), the CLI and
 the test suites.
@@ -10,7 +11,7 @@ the test suites.
 
 from __future__ import annotations
 
-from . import baselines, constructions  # noqa: F401  (importing them registers their entries)
+from . import baselines, constructions, progressive  # noqa: F401  (importing them registers their entries)
 from .catalogue_types import MAX_DIMS, REGISTRY, Construction, SppChoice, check_int
 
 #: Every sampler: the OA constructions, then the comparison samplers.
@@ -21,7 +22,8 @@ SAMPLERS: dict[str, Construction] = {
 
 
 def names(family: str | None = None) -> list[str]:
-    """The sampler names, of one family (``"oa"`` or ``"baseline"``) or all."""
+    """The sampler names, of one family (``"oa"``, ``"baseline"`` or
+    ``"progressive"``) or all."""
     return [n for n, c in SAMPLERS.items() if family is None or c.family == family]
 
 

@@ -221,6 +221,13 @@ class Construction:
     #: whether a sampler needs the image resolution (``resolution=``): its
     #: values depend on where a pixel lies in the image
     needs_resolution = False
+    #: whether every prefix of a pixel's samples keeps the sampler's
+    #: stratification (its first n samples are as good as any n): a render
+    #: may stop after any block of samples (``pyoa render --progressive``)
+    progressive = False
+    #: whether a pixel's i-th sample is the same for every ``spp``: a stopped
+    #: progressive render may continue to a larger count (``--resume``)
+    spp_invariant = False
 
     def __setattr__(self, key, value):
         # One shared instance per sampler name serves every Sampler: changing
@@ -279,6 +286,15 @@ class Construction:
             raise ValueError(f"{self.name} takes no resolution (got resolution={resolution!r}); only "
                              f"{', '.join(needing)} {'depends' if len(needing) == 1 else 'depend'} on where a "
                              "pixel lies in the image")
+        return params
+
+    def with_base(self, params: Params, base) -> Params:
+        """``params`` in the digit base ``base``: None for the samplers without
+        one (they refuse one), a prime for those with one (``faure``)."""
+        if base is not None:
+            having = [c.name for c in REGISTRY.values() if type(c).with_base is not Construction.with_base]
+            raise ValueError(f"{self.name} takes no base (got base={base!r}); only {', '.join(having)} "
+                             f"{'has' if len(having) == 1 else 'have'} a digit base")
         return params
 
     def pixel_count(self, params: Params) -> int:

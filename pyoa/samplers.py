@@ -260,8 +260,9 @@ class Sampler:
     samplers (``random``, ``jittered2d``, ``cmj2d``, ``sobol02``, ``halton``,
     ``sobol``) and pbrt-v4's ``zsobol`` (Z-order Sobol, blue-noise error
     across pixels; needs ``resolution``) and ``pmj02`` (progressive
-    multi-jittered (0,2)) share this class, its API and its bit-exactness
-    guarantees.
+    multi-jittered (0,2)), and pyoa's progressive ``faure`` (Owen-scrambled
+    Faure (0,s)-sequences: orthogonal arrays at every ``b**m``, any count)
+    share this class, its API and its bit-exactness guarantees.
 
     Create one with :func:`sampler`. Immutable (setting or deleting an
     attribute raises AttributeError: make a new sampler instead) and safe to
@@ -296,6 +297,8 @@ class Sampler:
     resolution : tuple of int or None
         ``(width, height)`` of the image for the samplers whose values depend
         on where a pixel lies in it (``zsobol``), else None.
+    base : int or None
+        The prime digit base of ``faure`` (given or its default), else None.
     n_pixels : int
         How many pixel indices are valid: ``width * height`` with a
         resolution (pixel ``y * width + x``), else ``2**32``.
@@ -307,7 +310,7 @@ class Sampler:
     """
 
     def __init__(self, name, *, spp, dims, seed=0, offset=None, jitter=1.0, strength=None, resolution=None,
-                 backend=None, device=None, max_bytes=None):
+                 base=None, backend=None, device=None, max_bytes=None):
         construction = catalogue.get(name)
         spp = _int("spp", spp, 1, MAX_SPP)
         dims = _int("dims", dims, 1, MAX_DIMS)
@@ -317,6 +320,7 @@ class Sampler:
         offset = _offset(construction, offset)
         jitter = _jitter(construction, jitter)
         params = construction.with_resolution(construction.resolve(spp, dims, strength), resolution)
+        params = construction.with_base(params, base)
         max_bytes = default_max_bytes() if max_bytes is None else parse_bytes(max_bytes, "max_bytes")
         impl = choose(backend, device)
         # Every attribute is set here and never again (see __setattr__).
@@ -324,6 +328,7 @@ class Sampler:
             _construction=construction, name=construction.name, spp=spp, dims=dims, seed=seed, offset=offset,
             jitter=jitter, params=params, s=params.s, strength=params.strength, block_dims=params.block_dims,
             resolution=params.resolution, n_pixels=construction.pixel_count(params),
+            base=params.s if construction.family == "progressive" else None,
             max_bytes=max_bytes, _backend=impl, _device_selector=device, backend=impl.name,
             device=impl.describe(),
         )
@@ -345,6 +350,7 @@ class Sampler:
             # the resolved strength, so the copy cannot resolve another one; the
             # comparison samplers take none
             strength=self.strength if self._construction.family == "oa" else None, resolution=self.resolution,
+            base=self.base,
             backend=self.backend, device=self._device_selector, max_bytes=self.max_bytes,
         )
 
@@ -362,7 +368,8 @@ class Sampler:
             return (
                 f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}"
                 f"{f', jitter={self.jitter:g}' if c.jittered else ''}"
-                f"{f', resolution={self.resolution}' if self.resolution else ''}{f'; grid {grid}' if grid else ''}; "
+                f"{f', resolution={self.resolution}' if self.resolution else ''}"
+                f"{f', base={self.base}' if self.base else ''}{f'; grid {grid}' if grid and not self.base else ''}; "
                 f"backend={self.backend!r} on {self.device})"
             )
         return (
@@ -540,8 +547,9 @@ def _output(out, shape: tuple[int, ...]) -> np.ndarray:
 
 
 def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None = None, jitter: float = 1.0,
-            strength: int | None = None, resolution: tuple[int, int] | None = None, backend: str | None = None,
-            device: str | None = None, max_bytes: int | float | str | None = None) -> Sampler:
+            strength: int | None = None, resolution: tuple[int, int] | None = None, base: int | None = None,
+            backend: str | None = None, device: str | None = None,
+            max_bytes: int | float | str | None = None) -> Sampler:
     """Create a sampler: an orthogonal array or one of the paper's comparison samplers.
 
     Parameters
@@ -557,7 +565,11 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         (``spp = 2**k``; every pixel's samples of a pair a (0,k,2)-net,
         blue-noise error across the image; needs `resolution`) and
         ``"pmj02"`` (progressive multi-jittered (0,2), ``spp = 2**k`` up to
-        ``2**16``, from a table built once and cached). See :func:`samplers`,
+        ``2**16``, from a table built once and cached). pyoa's progressive
+        orthogonal arrays: ``"faure"`` (Owen-scrambled Faure (0,s)-sequence
+        in a prime base, any ``spp``: every aligned block of ``b**m`` samples
+        a (0,m,b)-net, so ``b**2`` samples are a strength-2 array and a
+        render can stop and continue at any count). See :func:`samplers`,
         :func:`valid_spp` and ``docs/samplers.md``.
     spp : int
         Samples per pixel. An invalid count raises a ValueError naming the
@@ -587,6 +599,13 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         Morton order spans the image) and refused by the others. Pixels are
         then numbered row-major, ``pixel = y * width + x`` (as pyoa's
         renderer numbers them), and must be below ``width * height``.
+    base : int, optional
+        ``faure`` only (the others refuse it): its digit base, a prime in
+        ``[2, 4093]``; ``b`` dimensions per block, every ``b**m`` samples a
+        net. Default: the largest prime ``b`` with ``b**2 <= spp``, or the
+        smallest prime ``>= dims`` if smaller (see :class:`pyoa.progressive.Faure`).
+        A pixel's samples do not depend on ``spp`` for a given base: give it
+        to continue a sequence at another count.
     backend : {"opencl", "numpy"}, optional
         Default: ``$PYOA_BACKEND``, else OpenCL if usable, else NumPy with a
         warning (see :mod:`pyoa.backends`).
@@ -618,4 +637,4 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
     True
     """
     return Sampler(name, spp=spp, dims=dims, seed=seed, offset=offset, jitter=jitter, strength=strength,
-                   resolution=resolution, backend=backend, device=device, max_bytes=max_bytes)
+                   resolution=resolution, base=base, backend=backend, device=device, max_bytes=max_bytes)

@@ -677,3 +677,44 @@ def kernel_runner(backend, test_kernels: str):
         return results if len(results) > 1 else results[0]
 
     return run
+
+
+def compositions(m: int, k: int):
+    """Every way to split ``m`` digits among ``k`` dimensions (``e_1 + ... + e_k = m``, each >= 0)."""
+    if k == 1:
+        yield (m,)
+        return
+    for e in range(m + 1):
+        for rest in compositions(m - e, k - 1):
+            yield (e, *rest)
+
+
+def net_failures(x: np.ndarray, b: int, m: int, block_dims: int, max_k: int = 3, subsets=None) -> list[str]:
+    """Where the aligned blocks of ``b**m`` samples of ``x`` (pixels, N,
+    dims) are not (0, m, s)-nets in base ``b``: for every projection onto
+    ``k <= min(m, max_k)`` dimensions of one block of ``block_dims``
+    dimensions (or the given ``subsets``), and every split of the ``m``
+    digits among them, each elementary box must hold exactly one point of
+    every aligned block. Exact: ``floor(x * b**e)`` of a float32 is exact in
+    float64. Returns the failures (empty: every net holds)."""
+    P, N, D = x.shape
+    size = b**m
+    nblk = N // size
+    if nblk == 0:
+        return []
+    xs = np.asarray(x[:, :nblk * size], np.float64)
+    owner = (np.arange(P)[:, None] * nblk + np.arange(nblk * size)[None, :] // size)  # (pixel, block) id
+    if subsets is None:
+        subsets = [sub for b0 in range(0, D, block_dims)
+                   for k in range(1, min(m, max_k, min(D, b0 + block_dims) - b0) + 1)
+                   for sub in itertools.combinations(range(b0, min(D, b0 + block_dims)), k)]
+    fails = []
+    for sub in subsets:
+        for split in compositions(m, len(sub)):
+            code = owner * size  # box index within the block: sum of stratum * b**(digits after it)
+            for t, (c, e) in enumerate(zip(sub, split)):
+                code = code + np.floor(xs[:, :, c] * b**e).astype(np.int64) * b ** (m - sum(split[:t + 1]))
+            counts = np.bincount(code.ravel(), minlength=P * nblk * size)
+            if not (counts == 1).all():
+                fails.append(f"dims {sub} split {split}")
+    return fails

@@ -31,7 +31,7 @@ from hypothesis import strategies as st
 import pyoa
 from pyoa import catalogue
 from pyoa.catalogue_types import OFFSETS, Claim
-from tests.helpers import U32_MAX, assert_same_bits, reference_block
+from tests.helpers import U32_MAX, assert_same_bits, net_failures, reference_block
 
 ROOT = Path(__file__).resolve().parent.parent
 ENTRIES = list(catalogue.SAMPLERS.values())
@@ -263,6 +263,12 @@ def check_claim(claim: Claim, x: np.ndarray, what: str) -> None:
                     counts = np.stack([np.bincount(code[p], minlength=n) for p in range(P)])
                     assert counts.shape[-1] == n and (counts == 1).all(), \
                         f"{what}: pair {d}, first {n}: not a (0,{m},2)-net at 2^-{u} x 2^-{m - u}"
+    elif claim.kind == "faure":
+        # every aligned block of b^m samples a (0,m,s)-net in base b, m <= strength
+        # (which makes every prefix of lam b^m samples hold lam points per box)
+        for m in range(1, claim.strength + 1):
+            fails = net_failures(x, claim.s, m, claim.block_dims)
+            assert not fails, f"{what}: blocks of {claim.s}^{m} not nets at {fails[:3]}"
     else:  # pragma: no cover - a claim kind this suite does not know is a test failure
         raise AssertionError(f"{what}: unknown claim kind {claim.kind!r}")
 
@@ -294,7 +300,7 @@ def test_claims_fail_on_wrong_points():
     rng = np.random.default_rng(1)
     x = rng.random((2, 64, 4)).astype(np.float32)
     for claim in (Claim("oa", s=8, strength=2, block_dims=4), Claim("latin", n=64), Claim("grid", a=8, c=8),
-                  Claim("net", n=64)):
+                  Claim("net", n=64), Claim("faure", n=64, s=2, strength=3, block_dims=4)):
         with pytest.raises(AssertionError):
             check_claim(claim, x, claim.kind)
     assert math.isqrt(64) == 8

@@ -185,7 +185,7 @@ class OpenCLBackend:
             else:
                 buf = self._scratch("out", n_values * 4)
             dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
-            if req.construction.family == "baseline":
+            if req.construction.family != "oa":
                 a, b, c = (*req.construction.shape_args(prm), 0, 0, 0)[:3]
                 kernel = f"generate_{req.construction.function}"
                 extra = (np.uint32(req.seed), np.uint32(a), np.uint32(b), np.uint32(c), np.float32(req.jitter),
@@ -201,7 +201,7 @@ class OpenCLBackend:
             for rect in req.rectangles(row0, row1):
                 # each rectangle's values are a contiguous part of the chunk
                 at = np.uint32((rect.row0 - row0) * req.n_dims)
-                if req.construction.family == "baseline":
+                if req.construction.family != "oa":
                     bshp = vector.baseline_shape(req, rect) if use_vector else None
                     if bshp is not None:
                         self._launch_vector_baseline(req, rect, bshp, buf, at, dims)

@@ -155,7 +155,7 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     """The vector program for rectangle ``rect`` of ``req``, or None when the
     rectangle does not take the vector path (module docstring)."""
     prm = req.params
-    if req.construction.family == "baseline" or rect.n_k != len(req.samples) or rect.n_k < LANES:
+    if req.construction.family != "oa" or rect.n_k != len(req.samples) or rect.n_k < LANES:
         return None
     if not 1 <= req.n_dims <= MAX_DIMS:
         return None

@@ -1,0 +1,52 @@
+/* Owen-scrambled Faure (0,s)-sequences in a prime base b: the progressive
+ * orthogonal arrays of pyoa/reference/faure.py (the mathematics, its
+ * references and the float rule are there; this is the same computation,
+ * operation for operation). */
+
+/* FAURE_KEY and FAURE_DIGIT_KEY come from pyoa/reference/faure.py, their only
+ * definition, as -D build options (pyoa._opencl.program.defines()). */
+#ifndef FAURE_KEY
+#error "FAURE_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef FAURE_DIGIT_KEY
+#error "FAURE_DIGIT_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+
+/* Most index digits: 24, in base 2 (every index is below 2^24). */
+#define FAURE_MAX_DIGITS 24
+
+/* Sample i, dimension j in base b, with the Taylor shift over the n lowest
+ * digits of i (i < b^n; the host passes the digits of its largest index, the
+ * same for every work-item, so the loops below are uniform). */
+float sample_faure(uint i, uint j, uint b, uint n, uint p)
+{
+    uint col = j % b, block = j / b;
+    uint q = derived_seed(block_seed(p, block), col, FAURE_KEY);
+    uint a[FAURE_MAX_DIGITS];
+    uint rest = i;
+    for (uint r = 0u; r < n; r++) {
+        a[r] = rest % b;
+        rest /= b;
+    }
+    /* a becomes the coefficients of A(x + col) mod b: y_k = a[k]
+     * (repeated synthetic division; products stay below b^2 <= 2^24) */
+    for (uint k = 0u; k + 1u < n; k++)
+        for (uint r = n - 1u; r-- > k;)
+            a[r] = (a[r] + col * a[r + 1u]) % b;
+    /* nested scrambling of the K output digits, b^K >= 2^24 */
+    ulong numer = 0ul, power = 1ul;  /* power = b^k */
+    uint prefix = 0u;                /* (y_0 ... y_{k-1}) in base b */
+    for (uint k = 0u; power < 0x1000000ul; k++) {
+        uint y = k < n ? a[k] : 0u;
+        uint yy = q ? permute(y, b, hash_pair(q, (uint)power + prefix, FAURE_DIGIT_KEY)) : y;
+        numer = numer * b + yy;
+        prefix = prefix * b + y;
+        power *= b;
+    }
+    /* the cell clamp: keep the 24-bit value in its cell of b^-L, b^L <= 2^24
+     * (L = K for b = 2, where b^K = 2^24, else K - 1) */
+    ulong fine = power == 0x1000000ul ? power : power / b;
+    ulong x24 = (numer << 24) / power;
+    ulong lo = (((numer / (power / fine)) << 24) + fine - 1ul) / fine;
+    return convert_float((uint)max(x24, lo)) * 0x1.0p-24f;
+}

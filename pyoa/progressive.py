@@ -1,0 +1,156 @@
+"""The catalogue's progressive orthogonal arrays: Owen-scrambled Faure (0, s)-sequences.
+
+The orthogonal arrays of :mod:`pyoa.constructions` are finite: ``bose`` is
+stratified at ``N = s**2`` and nowhere else, and a render cannot continue
+with more samples. A (0, s)-sequence in a prime base ``b`` (Faure 1982 [1]_)
+removes both limits: every aligned block of ``b**m`` consecutive samples is
+a (0, m, s)-net, so the first ``b**2`` samples are an orthogonal array of
+strength 2 with ``b`` levels, the first ``b**3`` one of strength 3 that is
+also stratified on the ``b**2 x b`` grids of every pair (a strong orthogonal
+array), and every prefix of ``lam * b**m`` samples holds ``lam`` points in
+each elementary box of volume ``b**-m``. Owen's nested scrambling [2]_, with
+hash-based digit permutations, keeps all of it and makes each value a
+stateless function of ``(pixel, i, j)``. The mathematics is in
+:mod:`pyoa.reference.faure` and ``docs/samplers.md``.
+
+References
+----------
+.. [1] H. Faure, "Discrépance de suites associées à un système de
+   numération (en dimension s)", Acta Arithmetica 41, 1982.
+.. [2] A. B. Owen, "Randomly permuted (t,m,s)-nets and (t,s)-sequences",
+   Monte Carlo and Quasi-Monte Carlo Methods, 1995.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+
+from ._numpy import faure as _numpy_faure
+from .baselines import Baseline
+from .catalogue_types import MAX_SPP, Claim, Params, register
+from .reference import faure as _reference_faure
+
+#: Largest base (the largest prime ``b`` with ``b**2 <= 2**24``).
+MAX_BASE = _reference_faure.MAX_BASE
+
+
+def _primes_up_to(n: int) -> list[int]:
+    sieve = bytearray([1]) * (n + 1)
+    sieve[:2] = b"\0\0"
+    for k in range(2, math.isqrt(n) + 1):
+        if sieve[k]:
+            sieve[k * k::k] = bytearray(len(sieve[k * k::k]))
+    return [k for k in range(n + 1) if sieve[k]]
+
+
+#: Every valid base, in increasing order.
+BASES = tuple(_primes_up_to(MAX_BASE))
+
+
+def default_base(spp: int, dims: int | None = None) -> int:
+    """The base ``faure`` uses when none is given (the rule of :class:`Faure`).
+
+    The largest prime ``b_max`` with ``b_max**2 <= spp`` (strength 2 at
+    ``spp``, as many dimensions per block as that allows; 2 below 4 samples),
+    lowered to the smallest prime ``>= dims`` when that already holds every
+    dimension in one block (the same strength 2 and finer strata: more
+    digits fit in ``spp``).
+
+    >>> default_base(121), default_base(1000), default_base(1000, dims=5), default_base(3)
+    (11, 31, 5, 2)
+    """
+    root = math.isqrt(max(int(spp), 1))
+    b_max = max((b for b in BASES if b <= root), default=2)
+    if dims:
+        fits = next((b for b in BASES if b >= dims), None)
+        if fits is not None and fits <= b_max:
+            return fits
+    return b_max
+
+
+def _levels(b: int, spp: int) -> int:
+    """The largest ``m`` with ``b**m <= spp``: the prefix's first full net."""
+    m, power = 0, b
+    while power <= spp:
+        m, power = m + 1, power * b
+    return m
+
+
+@register
+class Faure(Baseline):
+    """``faure``: Owen-scrambled Faure (0, s)-sequence, progressive orthogonal arrays.
+
+    Any ``spp`` in ``[1, 2**24]``. ``base=b``, a prime in ``[2, 4093]``:
+    dimensions ``0 .. b-1`` are one (0, b)-sequence in base ``b``, so every
+    aligned block of ``b**m`` samples of a pixel is a (0, m, b)-net: at
+    ``N = b**2`` an orthogonal array of strength 2 (``b x b`` cells of every
+    pair, as ``bose``), at ``N = b**3`` every triple is stratified into
+    ``b x b x b`` cells and every pair into ``b**2 x b`` and ``b x b**2``
+    cells, and a prefix of ``lam * b**m`` samples puts ``lam`` in each box.
+    Dimensions past ``b`` come from independently scrambled copies (as the
+    OA samplers' blocks). Each digit is Owen-scrambled by hashes of the
+    pixel's seed, the dimension and the digits above it.
+
+    **Progressive**: a pixel's ``i``-th sample does not depend on ``spp``
+    (for a given ``base``), so a render can stop at any count and continue.
+
+    **Default base** (``base=None``): the largest prime ``b`` with
+    ``b**2 <= spp`` (strength 2 at ``spp`` with as many dimensions per block
+    as that allows, as ``bose`` chooses ``s``; 2 below 4 samples), or the
+    smallest prime ``>= dims`` when that is smaller (every dimension in one
+    block, finer strata). E.g. ``spp=1000, dims=8`` gives ``b=31`` (961
+    samples a strength-2 array of 31 dimensions); ``spp=1000, dims=5`` gives
+    ``b=5`` (625 samples a (0,4,5)-net: every 4-dimensional projection
+    stratified). The default depends on ``spp``: give ``base`` to continue a
+    sequence at another count. Math: :func:`pyoa.reference.faure.faure`.
+
+    >>> pyoa.sampler("faure", spp=121, dims=8).base   # doctest: +SKIP
+    11
+    """
+
+    name = "faure"
+    code = 13
+    family = "progressive"
+    progressive = True
+    spp_invariant = True
+    reference = staticmethod(_reference_faure.faure)
+    numpy = staticmethod(_numpy_faure.faure)
+    kernel = "sample_faure(i, j, a, b, p)"
+    description = (f"Owen-scrambled Faure (0,s)-sequence in a prime base b <= {MAX_BASE} (base=): any N, every "
+                   "b^m block a (0,m,b)-net, progressive")
+
+    def params(self, spp, dims):
+        b = default_base(spp, dims)
+        return Params(s=b, strength=_levels(b, spp), block_dims=b, M=spp, dims=dims or 0)
+
+    def detail(self, prm):
+        return f"b={prm.s}"
+
+    def with_base(self, params, base):
+        if base is None:
+            return params
+        if isinstance(base, bool) or not isinstance(base, numbers.Integral):
+            raise TypeError(f"base must be an int (a prime in [2, {MAX_BASE}]), got {type(base).__name__} {base!r}")
+        base = int(base)
+        if base not in BASES:
+            near = sorted(BASES, key=lambda b: (abs(b - base), b))[:2]
+            raise ValueError(f"faure: base must be a prime in [2, {MAX_BASE}], got {base}; nearest: "
+                             f"{', '.join(map(str, sorted(near)))}")
+        return dataclasses.replace(params, s=base, block_dims=base, strength=_levels(base, params.M))
+
+    def shape_args(self, params):
+        return (params.s, _reference_faure.index_digits(params.s, params.M))
+
+    def claims(self, params, offset):
+        return [Claim("faure", n=params.M, s=params.s, strength=min(3, max(params.strength, 1)),
+                      block_dims=params.s)]
+
+    def test_cases(self):
+        # one sample; a prime count over two blocks; b^2 at base 7; the largest
+        # count in base 2 (24 digits) and at the default (largest) base 4093;
+        # many blocks of base 31; a count just past a full net
+        return [dict(spp=1, dims=1), dict(spp=13, dims=7), dict(spp=49, dims=8, base=7),
+                dict(spp=MAX_SPP, dims=3, base=2), dict(spp=MAX_SPP, dims=3),
+                dict(spp=4, dims=600, base=31), dict(spp=28, dims=3, base=3)]
