@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
-import json
+import math
 import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -29,8 +27,10 @@ from .image import (
     write_png,
 )
 from .layout import MAX_DEPTH
+from .progressive import check_progressive, render_progressive, state_path
 from .render import SHADINGS, check_memory, plan, render, resolve_shading
 from .scene import load
+from .state import BadState, read_state, scene_digest, write_state
 
 #: Bytes per pixel that a command allocates besides the render, bounded: the
 #: PNG's float64 sRGB conversion, the reference and the float64 copies of
@@ -65,43 +65,65 @@ def _check_job_memory(p, what: str) -> None:
     check_memory(p.nbytes + p.width * p.height * POST_PIXEL_BYTES, what, p.max_bytes)
 
 
-def _plan(scene, args, sampler: str, spp: int, seed: int | None = None):
+def _plan(scene, args, sampler: str, spp: int, seed: int | None = None, base: int | None = None):
     return plan(scene, sampler=sampler, spp=spp, seed=args.seed if seed is None else seed, **_size(args),
-                max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend)
+                max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend, base=base)
 
 
 def cmd_render(args) -> int:
     _check_counts(args)
     if args.crop and not args.reference:
         raise ValueError("--crop needs --reference: it is the window of the relative MSE against it")
+    if not args.progressive and (args.time is not None or args.resume):
+        raise ValueError(f"{'--time' if args.time is not None else '--resume'} needs --progressive (a render that "
+                         "writes its image after every doubling of the samples)")
+    if args.progressive:
+        check_progressive(args.sampler)
+        if args.time is not None and not (math.isfinite(args.time) and args.time > 0):
+            raise ValueError(f"--time must be a positive number of seconds, got {args.time}")
     check_output(args.out, "--out", EXR)
     if args.png:
         check_output(args.png, "--png", PNG)
     scene = load(args.scene)
-    p = _plan(scene, args, args.sampler, args.spp)
+    p = _plan(scene, args, args.sampler, args.spp, base=args.base)
     _check_job_memory(p, f"pyoa render of {p.width} x {p.height} at {p.sampler.spp} spp")
     ref = None
     if args.reference:
         ref = read_reference(args.reference, "--reference", p.width, p.height)
         if args.crop:
             check_crop(args.crop, p.width, p.height)
-    res = render(scene, sampler=args.sampler, spp=args.spp, seed=args.seed,
-                 **_size(args),
-                 max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                 shading=args.shading, progress=not args.quiet)
-    check_finite(res.image, f"--out {args.out!r} not written")  # before either file is written
-    write_exr(args.out, res.image)
-    if args.png:
-        write_png(args.png, res.image)
-    if not args.quiet:
-        h, w = res.image.shape[:2]
-        print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
-        print(f"{res.seconds:.2f} s, {format_rate(res.paths_per_second)}paths/s, {format_rate(res.rays_per_second)}rays/s "
-              f"-> {args.out}{' and ' + args.png if args.png else ''}")
+    if args.progressive:
+        pres = render_progressive(scene, out=args.out, png=args.png, sampler=args.sampler, spp=args.spp,
+                                  seed=args.seed, base=args.base, **_size(args), max_depth=args.max_depth,
+                                  filter=args.filter, first=args.first, backend=args.backend,
+                                  shading=args.shading, time_budget=args.time, resume=args.resume,
+                                  quiet=args.quiet)
+        image = pres.image
+        if not args.quiet:
+            base = f" (base {pres.base})" if pres.base else ""
+            why = f", stopped by --time {args.time:g}" if pres.stopped_by_time else ""
+            print(f"{scene.name}: {pres.sampler}{base} {pres.samples} of {pres.spp} spp{why}; this run "
+                  f"{pres.samples - pres.resumed_from} samples in {pres.seconds:.2f} s -> {args.out}"
+                  f"{' and ' + args.png if args.png else ''} (running sum in {state_path(args.out)})")
+    else:
+        res = render(scene, sampler=args.sampler, spp=args.spp, seed=args.seed,
+                     **_size(args),
+                     max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
+                     shading=args.shading, progress=not args.quiet, base=args.base)
+        check_finite(res.image, f"--out {args.out!r} not written")  # before either file is written
+        write_exr(args.out, res.image)
+        if args.png:
+            write_png(args.png, res.image)
+        image = res.image
+        if not args.quiet:
+            h, w = res.image.shape[:2]
+            print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
+            print(f"{res.seconds:.2f} s, {format_rate(res.paths_per_second)}paths/s, "
+                  f"{format_rate(res.rays_per_second)}rays/s -> {args.out}{' and ' + args.png if args.png else ''}")
     if ref is not None:
-        line = f"relMSE {rel_mse(res.image, ref):.6g}"
+        line = f"relMSE {rel_mse(image, ref):.6g}"
         if args.crop:
-            line += f", crop {rel_mse(res.image, ref, args.crop):.6g}"
+            line += f", crop {rel_mse(image, ref, args.crop):.6g}"
         print(line)
     return 0
 
@@ -226,25 +248,13 @@ _KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (
                "seed": "--seed", "filter": "--filter", "first": "--first", "shading": "--shading"}
 
 
-def _scene_digest(scene) -> str:
-    """SHA-256 of what a scene renders: its file's bytes and its world-space
-    triangles (which include every mesh file it reads)."""
-    h = hashlib.sha256(Path(scene.path).read_bytes())
-    h.update(np.ascontiguousarray(scene.triangles).tobytes())
-    return h.hexdigest()
-
-
 def _reference_key(scene, args, p, passes: int) -> dict:
     """Every setting that changes the bits of a reference pass (the backend
     does not: every backend gives the same samples)."""
-    return dict(version=STATE_VERSION, scene=_scene_digest(scene), width=p.width, height=p.height,
+    return dict(version=STATE_VERSION, scene=scene_digest(scene), width=p.width, height=p.height,
                 max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=args.pass_spp, passes=passes,
                 seed=args.seed, filter=args.filter, first=list(p.layout.names),
                 shading=resolve_shading(args.shading))
-
-
-class _BadState(Exception):
-    """A state file that cannot be resumed (the message says why)."""
 
 
 def _describe_change(saved: dict, key: dict) -> str:
@@ -267,42 +277,6 @@ def _total_spp(key: dict):
         return "?"
 
 
-def _read_state(state: Path, key: dict) -> tuple[np.ndarray | None, int]:
-    """``(sum, done)`` saved in ``state`` for this run's ``key``; raises
-    _BadState when it cannot be resumed: unreadable, another run's, or
-    holding counts, a shape or values a mean of ``key``'s passes cannot have."""
-    shape = (key["height"], key["width"], 3)
-    limit = {"key.npy": 1 << 20, "passes.npy": 1 << 10, "sum.npy": 8 * int(np.prod(shape)) + (1 << 10)}
-    try:
-        with zipfile.ZipFile(state) as zf:
-            for info in zf.infolist():  # refuse a member larger than it can be before reading any
-                if info.file_size > limit.get(info.filename, 0):
-                    raise _BadState(f"unexpected member {info.filename!r} of {info.file_size} bytes")
-        with np.load(state, allow_pickle=False) as st:
-            try:
-                saved = json.loads(str(st["key"][()]))
-            except ValueError:
-                saved = None
-            if not isinstance(saved, dict):
-                raise _BadState("its key is not a JSON object")
-            if saved != key:
-                raise _BadState(_describe_change(saved, key))
-            done = st["passes"]
-            if done.shape != () or done.dtype.kind not in "iu" or not 0 <= int(done) <= key["passes"]:
-                raise _BadState(f"it counts {done.tolist()!r} passes done, not 0 to {key['passes']}")
-            done = int(done)
-            total = st["sum"]
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:  # truncated, empty, key-less
-        first = (str(exc).strip().splitlines() or [""])[0]
-        raise _BadState(f"unreadable ({type(exc).__name__}: {first})" if first else
-                        f"unreadable ({type(exc).__name__})") from None
-    if total.shape != shape or total.dtype != np.float64:
-        raise _BadState(f"its sum is {total.dtype} {total.shape}, not float64 {shape}")
-    if not np.isfinite(total).all():
-        raise _BadState("its sum holds NaN or inf")
-    return (total if done else None), done
-
-
 def _resume(state: Path, key: dict, quiet: bool) -> tuple[np.ndarray | None, int]:
     """The saved sum and pass count to resume from, or (None, 0) to start
     over, saying why on stderr: a state that is not this run's is never
@@ -310,8 +284,8 @@ def _resume(state: Path, key: dict, quiet: bool) -> tuple[np.ndarray | None, int
     if not state.exists():
         return None, 0
     try:
-        total, done = _read_state(state, key)
-    except _BadState as why:
+        total, done = read_state(state, key, "passes", key["passes"], _describe_change)
+    except BadState as why:
         print(f"pyoa reference: not resuming {state} ({why}): starting over", file=sys.stderr)
         return None, 0
     if not quiet:
@@ -341,7 +315,6 @@ def cmd_reference(args) -> int:
     p = _plan(scene, args, args.sampler, args.pass_spp)
     _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
     key = _reference_key(scene, args, p, passes)
-    text = json.dumps(key)
     total, done = _resume(state, key, args.quiet)
     from tqdm.auto import tqdm
 
@@ -353,9 +326,7 @@ def cmd_reference(args) -> int:
         check_finite(res.image, f"--out {args.out!r} not written: pass {k}")
         img = res.image.astype(np.float64)
         total = img if total is None else total + img
-        with atomic_path(state) as tmp:
-            with open(tmp, "wb") as fh:
-                np.savez(fh, sum=total, passes=k + 1, key=text)
+        write_state(state, total, "passes", k + 1, key)
     write_exr(args.out, (total / passes).astype(np.float32))
     state.unlink(missing_ok=True)
     if not args.quiet:
@@ -386,6 +357,16 @@ def add_parsers(sub) -> None:
     p = sub.add_parser("render", help="render a scene with one sampler (EXR, optional PNG)")
     common(p, 16)
     p.add_argument("--sampler", default="bose", help="sampler name (default bose)")
+    p.add_argument("--base", type=int, default=None,
+                   help="faure's prime digit base (default: chosen from --spp and the scene's dimensions)")
+    p.add_argument("--progressive", action="store_true",
+                   help="write the image after every doubling of the samples (1, 2, 4, ..., --spp) and keep the "
+                        "running sum in OUT.state.npz; progressive samplers only (faure, sobol, halton, ...)")
+    p.add_argument("--time", type=float, default=None, metavar="SECONDS",
+                   help="with --progressive: stop after the last doubling predicted to fit in SECONDS")
+    p.add_argument("--resume", action="store_true",
+                   help="with --progressive: continue OUT.state.npz (to a larger --spp too, for samplers whose "
+                        "samples do not depend on --spp: faure, sobol, halton, random)")
     p.add_argument("--out", default="render.exr", help="EXR output (default render.exr)")
     p.add_argument("--png", default=None, help="also write an sRGB PNG")
     p.add_argument("--reference", default=None, help="reference EXR: print the relative MSE")

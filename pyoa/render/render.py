@@ -74,6 +74,9 @@ class RenderResult:
     shading: str = "numba"
     #: seconds per stage summed over the worker threads (compiled shading only)
     timings: dict = field(default_factory=dict)
+    #: (integrator, shading) that rendered it, for a later render of the same
+    #: scene and settings to reuse (``render(..., integrator=)``)
+    integrator: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def paths_per_second(self) -> float:
@@ -160,7 +163,7 @@ class Plan:
 def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
          height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
          backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
-         max_bytes: int | str | None = None) -> Plan:
+         max_bytes: int | str | None = None, base: int | None = None) -> Plan:
     """Check the arguments of :func:`render` (same meanings) and the memory it
     needs, without rendering: every error a render can raise on its arguments
     is raised here, before anything large is allocated."""
@@ -179,10 +182,22 @@ def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: 
     # size; pixels are numbered row-major, y * width + x, as render() does
     image = {"resolution": (width, height)} if catalogue.get(sampler).needs_resolution else {}
     smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend, max_bytes=limit,
-                       **image)
+                       base=base, **image)
     nbytes = render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
     check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit)
     return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit)
+
+
+def _sample_range(samples, spp: int) -> range:
+    """The checked sample range of a render: ``range(spp)`` by default, else
+    a non-empty ``range(a, c)`` with step 1 inside ``[0, spp)``."""
+    if samples is None:
+        return range(spp)
+    if not isinstance(samples, range) or samples.step != 1 or not samples:
+        raise TypeError(f"samples must be a non-empty range(a, c) with step 1, got {samples!r}")
+    if samples.start < 0 or samples.stop > spp:
+        raise ValueError(f"samples {samples} must lie in [0, {spp}) (the sampler's spp)")
+    return samples
 
 
 class ShadingFallbackWarning(RuntimeWarning):
@@ -205,7 +220,9 @@ def _warn_fallback(exc: BaseException) -> None:
 def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
            height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
            backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
-           progress: bool = False, shading: str | None = None, max_bytes: int | str | None = None) -> RenderResult:
+           progress: bool = False, shading: str | None = None, max_bytes: int | str | None = None,
+           base: int | None = None, samples: range | None = None, sums: np.ndarray | None = None,
+           integrator=None) -> RenderResult:
     """Render ``scene`` (a :class:`pyoa.render.scene.Scene`) with ``spp`` samples per pixel.
 
     Parameters
@@ -241,6 +258,22 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         Memory limit (default ``$PYOA_MAX_BYTES``, else half of the RAM, as
         the samplers'): a render that would need more (:func:`render_bytes`)
         is refused with a ValueError before anything is allocated.
+    base : int, optional
+        The digit base of ``faure`` (refused by the other samplers).
+    samples : range, optional
+        Render only the samples ``samples`` (a contiguous ``range(a, c)``
+        with step 1 inside ``[0, spp)``) of every pixel: the image is their
+        mean. Default: all ``spp``. A progressive render
+        (:mod:`pyoa.render.progressive`) renders its blocks this way.
+    sums : numpy.ndarray, optional
+        A float64 array of shape ``(height, width, 3)`` that receives the
+        per-pixel *sums* of the samples' radiance (float64, exactly as the
+        mean is formed); the image is still returned.
+    integrator : optional
+        ``RenderResult.integrator`` of an earlier render of the same scene
+        with the same size, path length, layout and filter, reused instead of
+        built again (its setup, and the first call's compilation, are paid
+        once: a progressive render's blocks share one).
 
     Raises
     ------
@@ -252,11 +285,20 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     shading = resolve_shading(shading)
     p = plan(scene, sampler=sampler, spp=spp, seed=seed, width=width, height=height, max_depth=max_depth,
              filter=filter, first=first, backend=backend, batch_paths=batch_paths, threads=threads,
-             max_bytes=max_bytes)
+             max_bytes=max_bytes, base=base)
     width, height, layout, smp = p.width, p.height, p.layout, p.sampler
     spp, seed = smp.spp, smp.seed
+    samples = _sample_range(samples, spp)
+    n = len(samples)
+    if sums is not None and (not isinstance(sums, np.ndarray) or sums.dtype != np.float64
+                             or sums.shape != (height, width, 3) or not sums.flags.c_contiguous):
+        raise TypeError(f"sums must be a C-contiguous float64 array of shape {(height, width, 3)}")
     integ = None
-    if shading == "numba":
+    if integrator is not None:
+        integ, shading = integrator
+        if (getattr(integ, "width", width), getattr(integ, "height", height)) != (width, height):
+            raise ValueError("integrator was built for another image size")
+    elif shading == "numba":
         try:
             from .compiled.integrator import CompiledIntegrator
 
@@ -268,28 +310,34 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
             shading = "numpy"
     if integ is None:
         integ = Integrator(scene, layout, width, height, filter=filter)
+    if integrator is None:
+        integrator = (integ, shading)
     n_pixels = width * height
-    per_batch = max(1, batch_paths // spp)
+    per_batch = max(1, batch_paths // n)
     batches = [(p0, min(p0 + per_batch, n_pixels)) for p0 in range(0, n_pixels, per_batch)]
     out = np.empty((n_pixels, 3), dtype=np.float32)
+    flat_sums = None if sums is None else sums.reshape(n_pixels, 3)
     total = Stats()
 
     def run(batch):
         p0, p1 = batch
-        x = smp.generate(pixels=range(p0, p1)).reshape((p1 - p0) * spp, smp.dims)
-        pixel = np.repeat(np.arange(p0, p1), spp)
-        sample = np.tile(np.arange(spp), p1 - p0)
+        x = smp.generate(pixels=range(p0, p1), samples=samples).reshape((p1 - p0) * n, smp.dims)
+        pixel = np.repeat(np.arange(p0, p1), n)
+        sample = np.tile(np.arange(samples.start, samples.stop), p1 - p0)
         rad, st = integ.radiance(pixel, sample, x, seed=seed)
-        # per-pixel mean, summed along a contiguous axis: the same bits for any batch size
-        s = np.ascontiguousarray(rad.reshape(p1 - p0, spp, 3).transpose(0, 2, 1)).sum(axis=2)
-        out[p0:p1] = (s / spp).astype(np.float32)
+        # per-pixel sum along a contiguous axis: the same bits for any batch size
+        s = np.ascontiguousarray(rad.reshape(p1 - p0, n, 3).transpose(0, 2, 1)).sum(axis=2)
+        out[p0:p1] = (s / n).astype(np.float32)
+        if flat_sums is not None:
+            flat_sums[p0:p1] = s
         return st
 
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=n_pixels, unit="px", desc=f"{scene.name} {sampler} {spp} spp")
+        what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
+        bar = tqdm(total=n_pixels, unit="px", desc=f"{scene.name} {sampler} {what}")
     t0 = time.perf_counter()
     workers = max(1, min(threads or os.cpu_count() or 1, len(batches)))
     try:
@@ -302,6 +350,6 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - t0
-    return RenderResult(image=out.reshape(height, width, 3), sampler=smp.name, spp=spp, seed=seed,
+    return RenderResult(image=out.reshape(height, width, 3), sampler=smp.name, spp=n, seed=seed,
                         dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total, shading=shading,
-                        timings=dict(getattr(integ, "timings", {})))
+                        timings=dict(getattr(integ, "timings", {})), integrator=integrator)

@@ -1,0 +1,239 @@
+"""Progressive rendering: an image after every doubling of the sample count,
+a time budget, and resuming a stopped render to more samples.
+
+A progressive render traces samples ``[0, 1)``, ``[1, 2)``, ``[2, 4)``,
+``[4, 8)``, ... ``[2**k, spp)`` of every pixel in turn (one *block* per
+doubling, the last one cut at ``spp``) and, after each block, writes the
+mean of all samples so far to the output image (atomically) and the running
+sum to ``OUT.state.npz``. So
+
+- stopping at any moment (Ctrl-C, a killed job) leaves the image of the last
+  complete block;
+- ``time_budget`` stops after the last block that fits: before a block, its
+  time is predicted from the previous block's (time per sample) and the
+  block is skipped, and the render ends, if it would overrun the budget;
+- ``resume=True`` continues from the state: the samples already taken are
+  not traced again, and ``spp`` may be larger than the stopped render's,
+  for a sampler whose ``i``-th sample does not depend on ``spp``
+  (``spp_invariant``: ``faure`` with its base, ``sobol``, ``halton``,
+  ``random``).
+
+Doublings rather than powers of ``b`` (``faure``) or of 2 only: they suit
+every progressive sampler, give ``log2(spp)`` images, and a block is never
+more than the samples before it, so a time budget wastes at most half of
+itself.
+
+Only samplers whose every prefix keeps its stratification are accepted
+(``Construction.progressive``): the sequences (``faure``, ``sobol``,
+``halton``, ``sobol02``, ``pmj02``, ``zsobol``) and ``random``. An
+orthogonal array (``bose``...) or a jittered grid is stratified only as a
+whole: its first ``n`` samples are not a smaller array, so its intermediate
+images would be worse than random ones, and it is refused.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import catalogue
+from .image import check_finite, write_exr, write_png
+from .integrator import Stats
+from .render import plan, render, resolve_shading
+from .state import BadState, read_state, saved_key, scene_digest, write_state
+
+#: Version of the progressive state's layout and key.
+STATE_VERSION = 1
+#: Settings of the key, and how the user sets them (for the refusal to resume).
+_KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
+               "width": "--size W", "height": "--size H", "max_depth": "--max-depth", "sampler": "--sampler",
+               "base": "--base", "seed": "--seed", "filter": "--filter", "first": "--first",
+               "shading": "--shading", "spp": "--spp"}
+
+
+def block_ends(done: int, spp: int) -> list[int]:
+    """The sample counts after ``done`` at which the image is written: every
+    power of two above ``done`` and below ``spp``, then ``spp``.
+
+    >>> block_ends(0, 100)
+    [1, 2, 4, 8, 16, 32, 64, 100]
+    >>> block_ends(64, 256)
+    [128, 256]
+    """
+    ends = []
+    k = 1
+    while k < spp:
+        if k > done:
+            ends.append(k)
+        k *= 2
+    return ends + ([spp] if spp > done else [])
+
+
+def state_path(out) -> Path:
+    """Where a progressive render to ``out`` keeps its running sum."""
+    return Path(str(out) + ".state.npz")
+
+
+def check_progressive(name: str) -> None:
+    """Refuse (ValueError) a sampler whose prefixes are not stratified, saying why."""
+    entry = catalogue.get(name)
+    if entry.progressive:
+        return
+    ok = ", ".join(n for n, c in catalogue.SAMPLERS.items() if c.progressive)
+    why = ("an orthogonal array is stratified only as a whole (all N samples): its first samples are no smaller "
+           "array (bose's first s samples share one stratum of dimension 0), so its intermediate images would be "
+           "poor" if entry.family == "oa" else
+           "its grid is stratified only at the full count, not in its prefixes")
+    raise ValueError(f"{entry.name} cannot render progressively: {why}; progressive samplers: {ok}")
+
+
+def _describe_change(saved: dict, key: dict) -> str:
+    for fld, option in _KEY_FIELDS.items():
+        if saved.get(fld) != key.get(fld):
+            if fld in ("scene", "first", "version"):
+                return f"it was made with {option}"
+            if fld == "spp":
+                return (f"it was made with --spp {saved.get('spp')}, and {key['sampler']}'s samples depend on "
+                        f"--spp (continue it at --spp {saved.get('spp')})")
+            return f"it was made with {option} {saved.get(fld)}, not {key.get(fld)}"
+    return "it was made with other settings"  # pragma: no cover - keys differ in a field not listed
+
+
+@dataclass
+class ProgressiveResult:
+    """What a progressive render did: the image of ``samples`` samples per
+    pixel (written to ``out``), of the ``spp`` asked for."""
+
+    image: np.ndarray
+    samples: int
+    spp: int
+    sampler: str
+    base: int | None
+    #: samples per pixel already in the state when the run started
+    resumed_from: int
+    #: sample counts at which this run wrote an image
+    written: list = field(default_factory=list)
+    seconds: float = 0.0
+    #: whether the time budget ended the render before ``spp``
+    stopped_by_time: bool = False
+    stats: Stats = field(default_factory=Stats)
+
+
+def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, seed: int = 0,
+                       base: int | None = None, width: int | None = None, height: int | None = None,
+                       max_depth: int | None = None, filter: str = "box", first=None, backend: str | None = None,
+                       shading: str | None = None, png=None, time_budget: float | None = None,
+                       resume: bool = False, quiet: bool = True, max_bytes=None) -> ProgressiveResult:
+    """Render ``scene`` progressively to the EXR ``out`` (module docstring).
+
+    Parameters
+    ----------
+    out : path
+        EXR written after every block (atomically); the running sum is kept
+        in ``OUT.state.npz`` (:func:`state_path`), which stays after the
+        render so that it can be continued to more samples.
+    sampler, spp, seed, base, width, height, max_depth, filter, first, backend, shading, max_bytes
+        As for :func:`pyoa.render.render`; the sampler must be progressive
+        (:func:`check_progressive`). ``spp`` is the most samples rendered.
+    png : path, optional
+        Also write an sRGB PNG after every block.
+    time_budget : float, optional
+        Seconds: stop after the last block that is predicted to end within
+        it (the first block, one sample, is always rendered).
+    resume : bool
+        Continue from ``OUT.state.npz``. A state of other settings is
+        refused (ValueError saying which); without a state the render
+        starts from the first sample. Without ``resume`` an existing state
+        is replaced once the first block is done.
+    quiet : bool
+        No progress output.
+
+    Raises
+    ------
+    ValueError, TypeError
+        A sampler that is not progressive, a state that cannot be resumed,
+        one that holds more samples than ``spp``, a bad budget, or anything
+        :func:`pyoa.render.plan` refuses; all before the first sample.
+    """
+    t_start = time.perf_counter()
+    check_progressive(sampler)
+    if time_budget is not None:
+        if isinstance(time_budget, bool) or not isinstance(time_budget, (int, float)):
+            raise TypeError(f"time_budget must be a number of seconds, got {type(time_budget).__name__}")
+        if not (math.isfinite(time_budget) and time_budget > 0):
+            raise ValueError(f"time_budget must be a positive number of seconds, got {time_budget}")
+    state = state_path(out)
+    if state.is_dir():
+        raise ValueError(f"{str(state)!r} (where a progressive render keeps its running sum) is a directory; "
+                         "remove or rename it")
+    entry = catalogue.get(sampler)
+    saved = saved_key(state) if resume and state.exists() else None
+    if base is None and saved and saved.get("sampler") == entry.name and saved.get("base") is not None:
+        base = saved["base"]  # the default base depends on spp: keep the stopped render's
+    p = plan(scene, sampler=sampler, spp=spp, seed=seed, width=width, height=height, max_depth=max_depth,
+             filter=filter, first=first, backend=backend, base=base, max_bytes=max_bytes)
+    smp = p.sampler
+    key = dict(version=STATE_VERSION, scene=scene_digest(scene), width=p.width, height=p.height,
+               max_depth=p.layout.max_depth, sampler=smp.name, base=smp.base, seed=smp.seed, filter=filter,
+               first=list(p.layout.names), shading=resolve_shading(shading),
+               spp=None if entry.spp_invariant else smp.spp)
+    total, done = None, 0
+    if resume and state.exists():
+        try:
+            # the count is checked against spp below, with a clearer message
+            total, done = read_state(state, key, "samples", 1 << 24, _describe_change)
+        except BadState as why:
+            raise ValueError(f"cannot resume {state}: {why}; run without --resume to start over") from None
+        if done > smp.spp:
+            raise ValueError(f"cannot resume {state} at --spp {smp.spp}: it already holds {done} samples per "
+                             f"pixel; give --spp {done} or more")
+    elif resume and not quiet:
+        print(f"pyoa render: no {state} to resume; starting from the first sample", file=sys.stderr)
+    elif state.exists() and not quiet:
+        print(f"pyoa render: {state} exists; it is replaced (use --resume to continue it)", file=sys.stderr)
+    if total is None:
+        total = np.zeros((p.height, p.width, 3), np.float64)
+    result = ProgressiveResult(image=(total / max(done, 1)).astype(np.float32), samples=done, spp=smp.spp,
+                               sampler=smp.name, base=smp.base, resumed_from=done)
+    if not quiet and done:
+        print(f"resuming {state}: {done} of {smp.spp} samples per pixel done")
+    integrator = None
+    block = np.empty_like(total)
+    last_rate = None  # seconds per sample of the previous block
+    for end in block_ends(done, smp.spp):
+        n = end - done
+        elapsed = time.perf_counter() - t_start
+        if time_budget is not None and last_rate is not None and elapsed + last_rate * n > time_budget:
+            result.stopped_by_time = True
+            break
+        t0 = time.perf_counter()
+        res = render(scene, sampler=sampler, spp=smp.spp, seed=seed, width=p.width, height=p.height,
+                     max_depth=max_depth, filter=filter, first=first, backend=backend, shading=shading,
+                     max_bytes=max_bytes, base=smp.base, samples=range(done, end), sums=block,
+                     integrator=integrator)
+        integrator = res.integrator
+        last_rate = (time.perf_counter() - t0) / n
+        check_finite(res.image, f"--out {str(out)!r} not updated past {done} samples")
+        total += block
+        done = end
+        image = (total / done).astype(np.float32)
+        write_exr(out, image)
+        if png:
+            write_png(png, image)
+        write_state(state, total, "samples", done, key)
+        result.stats.add(res.stats)
+        result.written.append(done)
+        result.image, result.samples = image, done
+        if not quiet:
+            print(f"{done} of {smp.spp} samples per pixel -> {out} ({time.perf_counter() - t_start:.1f} s)")
+    result.seconds = time.perf_counter() - t_start
+    if not result.written and done:  # resumed a finished render: write its image again
+        write_exr(out, result.image)
+        if png:
+            write_png(png, result.image)
+    return result
