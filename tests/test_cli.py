@@ -85,7 +85,7 @@ def test_bad_spp_exits_2(tmp_path, capsys):
 @pytest.mark.parametrize("args, words", [
     (["--seed", "-1"], ["seed"]),
     (["--jitter", "2"], ["jitter"]),
-    (["--sampler", "faure"], ["faure"]),
+    (["--sampler", "niederreiter"], ["niederreiter"]),
     (["--dims", "0"], ["dims"]),
     (["--pixel0", "4294967295", "--pixels", "2"], ["pixels"]),
 ])
@@ -177,8 +177,8 @@ def test_spp_command(capsys):
     assert [ln.split() for ln in lines[1:]] == [["121", "11", "2", "12"], ["169", "13", "2", "14"]]
     code, out, _ = run_cli(["spp", "cmjnd", "--strength", "3", "--limit", "3"], capsys)
     assert code == 0 and "8     2   3" in out and "more" in out
-    code, _, err = run_cli(["spp", "faure"], capsys)
-    assert code == 2 and "faure" in err
+    code, _, err = run_cli(["spp", "niederreiter"], capsys)
+    assert code == 2 and "niederreiter" in err
 
 
 def test_backends_command(capsys):

@@ -293,8 +293,8 @@ def test_valid_spp():
     assert cubes[1].label() == "27 (s=3, t=3)"
     two = pyoa.valid_spp("cmjnd", dims=2)
     assert {c.strength for c in two} == {2} and two[-1].spp == 4096**2
-    with pytest.raises(ValueError, match="unknown sampler 'faure'"):
-        pyoa.valid_spp("faure")
+    with pytest.raises(ValueError, match="unknown sampler 'niederreiter'"):
+        pyoa.valid_spp("niederreiter")
 
 
 # ----------------------------------------------------------------------------- order and chunk independence
@@ -533,7 +533,7 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="bose", spp=121, jitter="0.5"), TypeError, ["jitter"]),
     (dict(name="bose", spp=121, jitter=None), TypeError, ["jitter"]),
     (dict(name="bose", spp=121, jitter=True), TypeError, ["jitter"]),
-    (dict(name="faure", spp=121), ValueError, ["faure", "bose", "cmjnd", "sobol02"]),
+    (dict(name="niederreiter", spp=121), ValueError, ["niederreiter", "bose", "cmjnd", "sobol02"]),
     (dict(name=3, spp=121), TypeError, ["name"]),
     (dict(name="bose", spp=121, backend="cuda"), ValueError, ["cuda", "opencl", "numpy"]),
     (dict(name="bose", spp=121, backend=1), TypeError, ["backend"]),
