@@ -92,7 +92,8 @@ def cmd_points(args) -> int:
     pixels = _pixel_range(args)
     check_out(args.out, FORMATS)
     options = dict(offset=args.offset, jitter=args.jitter, strength=args.strength, backend=args.backend,
-                   device=args.device, resolution=tuple(args.resolution) if args.resolution else None)
+                   device=args.device, resolution=tuple(args.resolution) if args.resolution else None,
+                   base=args.base)
     smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, **trial_options(args.sampler, options))
     t0 = time.perf_counter()
     x = smp.generate(pixels=pixels, progress=not args.quiet)
@@ -121,6 +122,10 @@ def cmd_spp(args) -> int:
         print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
         for c in choices[: args.limit]:
             print(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}")
+    elif get(args.sampler).family == "progressive":  # any count; the default base of each
+        print(f"{'spp':>9s} {'base':>5s} {'full nets':>10s} {'dims/block':>10s}")
+        for c in choices[: args.limit]:
+            print(f"{c.spp:9d} {c.s:5d} {f'{c.s}^{c.strength}':>10s} {c.block_dims:10d}")
     else:  # comparison samplers: their grid (if any) instead of s and t
         print(f"{'spp':>9s} {'grid':>11s}")
         for c in choices[: args.limit]:
@@ -139,6 +144,8 @@ def _options(args) -> dict:
         opts["jitter"] = args.jitter
     if args.strength is not None:
         opts["strength"] = args.strength
+    if args.base is not None:
+        opts["base"] = args.base
     return opts
 
 
@@ -203,6 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jitter", type=float, default=1.0,
                    help="jitter amount in [0, 1] (OA samplers, jittered2d, cmj2d; default 1)")
     p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
+    p.add_argument("--base", type=int, default=None,
+                   help="faure's prime digit base (default: the largest prime b with b^2 <= spp, or the smallest "
+                        "prime >= dims if smaller)")
     p.add_argument("--resolution", type=int, nargs=2, metavar=("W", "H"), default=None,
                    help="image size of a sampler that needs one (zsobol; pixels row-major, y*W + x); "
                         "default 65536 65536")
@@ -234,6 +244,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--offset", choices=OFFSETS, default=None, help="offset style of OA samplers")
         p.add_argument("--jitter", type=float, default=None, help="jitter amount in [0, 1]")
         p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
+        p.add_argument("--base", type=int, default=None, help="faure's prime digit base")
         p.add_argument("--backend", choices=("opencl", "numpy"), default=None)
         p.add_argument("--size", type=int, default=900, help="figure size in pixels (default 900)")
         p.add_argument("--out", default=out, help=f"PNG output (default {out})")
