@@ -11,9 +11,21 @@
 #ifndef FAURE_DIGIT_KEY
 #error "FAURE_DIGIT_KEY undefined: build with pyoa._opencl.program.defines()"
 #endif
+#ifndef FAURE_INDEX_KEY
+#error "FAURE_INDEX_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
 
-/* Most index digits: 24, in base 2 (every index is below 2^24). */
+/* Most digits K (b^K >= 2^24): 24, in base 2. */
 #define FAURE_MAX_DIGITS 24
+
+/* The fewest base-b digits K with b^K >= 2^24. */
+static inline uint faure_digits(uint b)
+{
+    uint K = 0u;
+    for (ulong power = 1ul; power < 0x1000000ul; power *= b)
+        K++;
+    return K;
+}
 
 /* Sample i, dimension j in base b, with the Taylor shift over the n lowest
  * digits of i (i < b^n; the host passes the digits of its largest index, the
@@ -21,12 +33,26 @@
 float sample_faure(uint i, uint j, uint b, uint n, uint p)
 {
     uint col = j % b, block = j / b;
-    uint q = derived_seed(block_seed(p, block), col, FAURE_KEY);
+    uint P = block_seed(p, block);
+    uint q = derived_seed(P, col, FAURE_KEY);
     uint a[FAURE_MAX_DIGITS];
+    if (block)  /* a copy: all K digits of its nested-scrambled index */
+        n = faure_digits(b);
     uint rest = i;
     for (uint r = 0u; r < n; r++) {
         a[r] = rest % b;
         rest /= b;
+    }
+    if (block) {
+        /* every copy past the first reads the sequence in its own nested
+         * order: digit r permuted by a hash of the digits above it */
+        uint s = hash_pair(P, b, FAURE_INDEX_KEY), high = 0u, power = 1u;
+        for (uint r = n; r-- > 0u;) {
+            uint d = a[r];
+            a[r] = permute(d, b, hash_pair(s, power + high, FAURE_DIGIT_KEY));
+            high = high * b + d;
+            power *= b;
+        }
     }
     /* a becomes the coefficients of A(x + col) mod b: y_k = a[k]
      * (repeated synthetic division; products stay below b^2 <= 2^24) */

@@ -90,7 +90,8 @@ class Faure(Baseline):
     ``b x b x b`` cells and every pair into ``b**2 x b`` and ``b x b**2``
     cells, and a prefix of ``lam * b**m`` samples puts ``lam`` in each box.
     Dimensions past ``b`` come from independently scrambled copies (as the
-    OA samplers' blocks). Each digit is Owen-scrambled by hashes of the
+    OA samplers' blocks), each reading the sequence in its own nested order
+    of the samples, so that no dimension is a function of another. Each digit is Owen-scrambled by hashes of the
     pixel's seed, the dimension and the digits above it.
 
     **Progressive**: a pixel's ``i``-th sample does not depend on ``spp``
@@ -100,10 +101,10 @@ class Faure(Baseline):
     ``b**2 <= spp`` (strength 2 at ``spp`` with as many dimensions per block
     as that allows, as ``bose`` chooses ``s``; 2 below 4 samples), or the
     smallest prime ``>= dims`` when that is smaller (every dimension in one
-    block, finer strata). E.g. ``spp=1000, dims=8`` gives ``b=31`` (961
-    samples a strength-2 array of 31 dimensions); ``spp=1000, dims=5`` gives
-    ``b=5`` (625 samples a (0,4,5)-net: every 4-dimensional projection
-    stratified). The default depends on ``spp``: give ``base`` to continue a
+    block, finer strata). E.g. ``spp=1000, dims=40`` gives ``b=31`` (961
+    samples a strength-2 array of 31 dimensions per block); ``spp=1000,
+    dims=8`` gives ``b=11``; ``spp=1000, dims=5`` gives ``b=5`` (625 samples
+    a (0,4,5)-net: every 4-dimensional projection stratified). The default depends on ``spp``: give ``base`` to continue a
     sequence at another count. Math: :func:`pyoa.reference.faure.faure`.
 
     >>> pyoa.sampler("faure", spp=121, dims=8).base   # doctest: +SKIP

@@ -54,7 +54,11 @@ points keeps its points exactly, in float32.
 
 **Dimensions beyond ``b``** come from independently scrambled copies, as for
 the orthogonal arrays (docs/spec.md section 6): dimension ``j`` is
-coordinate ``j mod b`` of the copy with seed ``block_seed(p, j // b)``.
+coordinate ``j mod b`` of the copy with seed ``block_seed(p, j // b)``, and
+a copy reads the sequence in its own nested order of the samples
+(:func:`index_scramble`): were it to read sample ``i`` as the first block
+does, dimension ``c + b`` would share every digit with dimension ``c`` and
+be a fixed function of it.
 
 ``p == 0`` gives the unscrambled Faure sequence in its first ``b``
 dimensions (the other blocks are scrambled: no coordinate repeats).
@@ -79,6 +83,7 @@ from .hashes import MASK, block_seed, hash_pair, permute
 #: Keys of the per-dimension and per-digit seeds (pyoa's choice).
 FAURE_KEY = 0x3C6EF372
 FAURE_DIGIT_KEY = 0xA54FF53A
+FAURE_INDEX_KEY = 0x510E527F
 
 #: Largest base: the largest prime ``b`` with ``b**2 <= 2**24``, so that
 #: every base reaches strength 2 within the samplers' limit of ``2**24``.
@@ -126,6 +131,30 @@ def index_digits(b: int, n: int) -> int:
     return digits
 
 
+def index_scramble(a: list[int], b: int, s: int) -> list[int]:
+    """The digits ``a`` (least significant first) of an index, each permuted
+    by a hash of ``s`` and of every digit above it (a nested scramble, from
+    the most significant digit down)::
+
+        a'_r = permute(a_r, b, hash_pair(s, b**(D-1-r) + (a_(D-1) ... a_(r+1))_b, FAURE_DIGIT_KEY))
+
+    with ``D = len(a)``. It maps every aligned block of ``b**m`` indices onto
+    an aligned block of ``b**m`` indices, so a copy of the sequence read in
+    this order keeps every net (and every prefix) of the sequence, while its
+    samples are paired with the first copy's at random: dimension ``c + b``
+    is no function of dimension ``c``, as it would be if both read sample
+    ``i`` of the same sequence (they then share every digit).
+    """
+    D = len(a)
+    out = list(a)
+    high, power = 0, 1  # high = (a_(D-1) ... a_(r+1)) in base b, power = b**(D-1-r)
+    for r in range(D - 1, -1, -1):
+        out[r] = permute(a[r], b, hash_pair(s, power + high, FAURE_DIGIT_KEY))
+        high = high * b + a[r]
+        power *= b
+    return out
+
+
 def faure(i: int, j: int, b: int, n: int, p: int) -> float:
     """Value of sample ``i``, dimension ``j`` of the Owen-scrambled Faure
     sequence in base ``b`` with seed ``p`` (module docstring).
@@ -155,17 +184,22 @@ def faure(i: int, j: int, b: int, n: int, p: int) -> float:
     if not 0 <= p <= MASK:
         raise ValueError(f"seed p must be a uint32 in [0, 2**32), got {p}")
     col, block = j % b, j // b
-    q = derived_seed(block_seed(p, block), col, FAURE_KEY)
+    P = block_seed(p, block)
+    q = derived_seed(P, col, FAURE_KEY)
+    K = out_digits(b)
     a = []
     rest = i
-    for _ in range(n):
+    for _ in range(K if block else n):
         a.append(rest % b)
         rest //= b
+    if block:
+        # every copy past the first reads the sequence in its own nested order
+        a = index_scramble(a, b, hash_pair(P, b, FAURE_INDEX_KEY))
+        n = K
     # Taylor shift: a becomes the coefficients of A(x + col) mod b, y_k = a[k]
     for k in range(n - 1):
         for r in range(n - 2, k - 1, -1):
             a[r] = (a[r] + col * a[r + 1]) % b
-    K = out_digits(b)
     numer, prefix, power = 0, 0, 1  # power = b**k, prefix = (y_0 ... y_{k-1})_b
     for k in range(K):
         y = a[k] if k < n else 0
