@@ -455,6 +455,7 @@ class PMJ02(Baseline):
     name = "pmj02"
     code = 12
     progressive = True
+    spp_invariant = True  # log2n only bounds i: the index scramble covers all 2**16
     counts = "pow2"
     max_spp = _reference_pmj02.POINTS
     reference = staticmethod(_reference_pmj02.pmj02)

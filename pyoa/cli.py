@@ -22,7 +22,7 @@ from . import OFFSETS, backends, sampler, samplers, valid_spp
 from .atomic import atomic_path, check_writable
 from .backends import BackendUnavailable, PyoaFallbackWarning
 from .catalogue import get
-from .catalogue_types import MAX_UINT32, check_int
+from .catalogue_types import MAX_UINT32, SppChoice, check_int
 from .samplers import trial_options
 from .units import format_rate
 
@@ -91,9 +91,9 @@ def _pixel_range(args) -> range:
 def cmd_points(args) -> int:
     pixels = _pixel_range(args)
     check_out(args.out, FORMATS)
-    options = dict(offset=args.offset, jitter=args.jitter, strength=args.strength, backend=args.backend,
-                   device=args.device, resolution=tuple(args.resolution) if args.resolution else None,
-                   base=args.base)
+    options = {"offset": args.offset, "jitter": args.jitter, "strength": args.strength, "backend": args.backend,
+               "device": args.device, "resolution": tuple(args.resolution) if args.resolution else None,
+               "base": args.base}
     smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, **trial_options(args.sampler, options))
     t0 = time.perf_counter()
     x = smp.generate(pixels=pixels, progress=not args.quiet)
@@ -114,21 +114,37 @@ def cmd_samplers(args) -> int:
     return 0
 
 
+def _in_base(name: str, choices, base: int, dims: int | None) -> list[SppChoice]:
+    """``choices`` in the digit base ``base`` (``pyoa spp faure --base B``);
+    a sampler without a base refuses it, with its own message, as
+    :func:`pyoa.sampler` does."""
+    entry = get(name)
+    rebased = []
+    for c in choices:
+        prm = entry.with_base(entry.solve(c.spp, dims, None), base)
+        rebased.append(SppChoice(c.spp, prm.s, prm.strength, prm.block_dims, entry.detail(prm)))
+    return rebased
+
+
 def cmd_spp(args) -> int:
     _option(args, "limit", 1)
     # valid_spp refuses --near, --dims and --strength values the sampler cannot have
     choices = valid_spp(args.sampler, near=args.near, dims=args.dims, strength=args.strength)
+    shown = choices[: args.limit]
+    if args.base is not None:
+        shown = _in_base(args.sampler, shown, args.base, args.dims)
     if get(args.sampler).family == "oa":
         print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
-        for c in choices[: args.limit]:
+        for c in shown:
             print(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}")
-    elif get(args.sampler).family == "progressive":  # any count; the default base of each
+    elif get(args.sampler).family == "progressive":  # any count; the base of each (given or default)
+        # full nets b^m: the largest m with b^m <= spp (aligned blocks of b^m samples are nets)
         print(f"{'spp':>9s} {'base':>5s} {'full nets':>10s} {'dims/block':>10s}")
-        for c in choices[: args.limit]:
+        for c in shown:
             print(f"{c.spp:9d} {c.s:5d} {f'{c.s}^{c.strength}':>10s} {c.block_dims:10d}")
     else:  # comparison samplers: their grid (if any) instead of s and t
         print(f"{'spp':>9s} {'grid':>11s}")
-        for c in choices[: args.limit]:
+        for c in shown:
             print(f"{c.spp:9d} {c.detail or '-':>11s}")
     if len(choices) > args.limit:
         print(f"... {len(choices) - args.limit} more (use --near N or --limit)")
@@ -230,6 +246,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--near", type=int, default=None, help="only the counts nearest this one")
     p.add_argument("--dims", type=int, default=None)
     p.add_argument("--strength", type=int, default=None)
+    p.add_argument("--base", type=int, default=None,
+                   help="faure's prime digit base (default: each count's default base, given --dims)")
     p.add_argument("--limit", type=int, default=40, help="print at most this many (default 40)")
     p.set_defaults(func=cmd_spp)
 

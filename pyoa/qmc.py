@@ -88,12 +88,17 @@ class OrthogonalArray(qmc.QMCEngine):
         (``"bose"``, the default; ``"bush"``, ``"cmjnd"``,
         ``"addelman-kempthorne"``, ``"bose-bush"``) or a comparison sampler
         (``"random"``, ``"jittered2d"``, ``"cmj2d"``, ``"sobol02"``,
-        ``"halton"``, ``"sobol"``, ``"zsobol"``, ``"pmj02"``). ``zsobol``
+        ``"halton"``, ``"sobol"``, ``"zsobol"``, ``"pmj02"``) or the
+        progressive ``"faure"`` (any `spp`; see `base`). ``zsobol``
         needs an image: the engine's arrays are pixels ``0, 1, ...`` of
         :data:`pyoa.samplers.TRIAL_RESOLUTION` (65536 x 65536, row-major).
     strength : int, optional
         ``bush`` and ``cmjnd`` only: the strength t, with ``spp = s**t``.
         Default: pyoa's (the largest ``t <= d`` for which `spp` is a t-th power).
+    base : int, optional
+        ``faure`` only: its prime digit base ``b`` in ``[2, 4093]`` (every
+        aligned block of ``b**m`` points of an array is a (0, m, b)-net).
+        Default: pyoa's, from `spp` and `d` (see :func:`pyoa.sampler`).
     offset : {"cmj", "mj", "j", "centered"}, optional
         Orthogonal arrays only: where a point sits inside its coarse stratum
         (default ``"cmj"``, correlated multi-jittered). See :func:`pyoa.sampler`.
@@ -134,6 +139,8 @@ class OrthogonalArray(qmc.QMCEngine):
         The pyoa sampler.
     s, strength, block_dims : int
         The construction's strata per axis, strength t and dimensions per block.
+    base : int or None
+        ``faure``'s digit base (given or its default), else None.
     pyoa_seed : int
         The uint32 user seed drawn from `rng`: point ``k*spp + i`` of the
         sequence is ``pyoa_sampler.generate(pixels=[k], samples=[i])[0, 0]``.
@@ -225,7 +232,7 @@ class OrthogonalArray(qmc.QMCEngine):
     """
 
     def __init__(self, d, *, spp=None, sampler="bose", strength=None, offset=None, jitter=1.0,
-                 optimization=None, rng=None, seed=None, backend=None, max_bytes=None) -> None:
+                 optimization=None, rng=None, seed=None, backend=None, max_bytes=None, base=None) -> None:
         if isinstance(d, bool) or not isinstance(d, numbers.Integral) or d < 1:
             raise ValueError(f"d must be a positive integer value, got {d!r}")
         d = int(d)
@@ -253,24 +260,26 @@ class OrthogonalArray(qmc.QMCEngine):
                 raise ValueError(f"{name} has no valid sample count for d={d}, strength={strength}")
         self.pyoa_seed = _draw_seed(self.rng)
         # pyoa validates spp (naming the nearest valid counts), strength,
-        # offset, jitter and backend.
+        # offset, jitter, base and backend.
         self.pyoa_sampler = Sampler(name, spp=spp, dims=d, seed=self.pyoa_seed, **trial_options(name, dict(
-            offset=offset, jitter=jitter, strength=strength, backend=backend, max_bytes=max_bytes)))
+            offset=offset, jitter=jitter, strength=strength, base=base, backend=backend, max_bytes=max_bytes)))
         smp = self.pyoa_sampler
         self.sampler_name = smp.name
         self.spp = smp.spp
         self.s, self.strength, self.block_dims = smp.s, smp.strength, smp.block_dims
+        self.base = smp.base
         self.maxn = self.spp * (MAX_UINT32 + 1)
         # Used by `scipy.integrate.qmc_quad` to build independent engines.
         self._init_quad = {"d": d, "spp": self.spp, "sampler": self.sampler_name, "strength": strength,
                            "offset": offset, "jitter": jitter, "optimization": optimization,
-                           "backend": backend, "max_bytes": smp.max_bytes}
+                           "backend": backend, "max_bytes": smp.max_bytes, "base": smp.base}
 
     def __repr__(self) -> str:
         smp = getattr(self, "pyoa_sampler", None)
         if smp is None:  # construction failed part-way
             return super().__repr__()
         extra = f", offset={smp.offset!r}" if smp.offset is not None else ""
+        extra += f", base={smp.base}" if smp.base is not None else ""
         return (f"OrthogonalArray(d={self.d}, spp={self.spp}, sampler={self.sampler_name!r}{extra}, "
                 f"pyoa_seed={self.pyoa_seed}; s={self.s}, strength={self.strength}, "
                 f"block_dims={self.block_dims}; num_generated={self.num_generated})")

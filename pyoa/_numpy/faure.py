@@ -11,7 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..reference.faure import FAURE_DIGIT_KEY, FAURE_INDEX_KEY, FAURE_KEY, cell_digits, out_digits
+from ..reference.faure import (
+    FAURE_DIGIT_KEY,
+    FAURE_INDEX_KEY,
+    FAURE_KEY,
+    cell_digits,
+    out_digits,
+)
 from .baselines import derived_seed
 from .floats import F32
 from .hashes import U32, _u32, block_seed, hash_pair, permute
@@ -28,7 +34,8 @@ def _index_scramble(a: list, b: int, s) -> list:
     for r in range(len(a) - 1, -1, -1):
         key = np.where(s == 0, U32(0), hash_pair(s, U32(power) + high, FAURE_DIGIT_KEY))
         out[r] = permute(a[r], b, key)
-        high = high * U32(b) + a[r]
+        if r:  # the last one is never used (and could pass 2**32)
+            high = high * U32(b) + a[r]
         power *= b
     return out
 
@@ -63,7 +70,8 @@ def faure(i, j, b: int, n: int, p) -> np.ndarray:
         y = a[k] if k < n else zero
         key = np.where(q == 0, U32(0), hash_pair(q, U32(power) + prefix, FAURE_DIGIT_KEY))
         numer = numer * U64(b) + permute(y, b, key)
-        prefix = prefix * ub + y
+        if k + 1 < K:  # the last prefix is never used (and could pass 2**32)
+            prefix = prefix * ub + y
         power *= b
     x24 = (numer << U64(24)) // U64(power)
     fine = b ** cell_digits(b)

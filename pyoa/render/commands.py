@@ -366,7 +366,7 @@ def add_parsers(sub) -> None:
                    help="with --progressive: stop after the last doubling predicted to fit in SECONDS")
     p.add_argument("--resume", action="store_true",
                    help="with --progressive: continue OUT.state.npz (to a larger --spp too, for samplers whose "
-                        "samples do not depend on --spp: faure, sobol, halton, random)")
+                        "samples do not depend on --spp: faure, sobol, halton, pmj02, random)")
     p.add_argument("--out", default="render.exr", help="EXR output (default render.exr)")
     p.add_argument("--png", default=None, help="also write an sRGB PNG")
     p.add_argument("--reference", default=None, help="reference EXR: print the relative MSE")

@@ -16,7 +16,7 @@ sum to ``OUT.state.npz``. So
   not traced again, and ``spp`` may be larger than the stopped render's,
   for a sampler whose ``i``-th sample does not depend on ``spp``
   (``spp_invariant``: ``faure`` with its base, ``sobol``, ``halton``,
-  ``random``).
+  ``pmj02``, ``random``).
 
 Doublings rather than powers of ``b`` (``faure``) or of 2 only: they suit
 every progressive sampler, give ``log2(spp)`` images, and a block is never
