@@ -41,7 +41,7 @@ of a few seconds; such results are marked ``quick`` and are not comparable
 with a full run. ``--cases all`` adds every other case (each OA
 construction and offset, and the comparison samplers); that takes about 15
 minutes, so they are opt-in. ``--cases baselines`` runs every comparison sampler of the catalogue
-(about 8 minutes with the default case).
+and every progressive one (``faure``; about 8 minutes with the default case).
 
 Peers
 -----
@@ -152,13 +152,14 @@ CASES: dict[str, dict] = {
                                 about="Bose-Bush s=8 in GF(16) (index 2), correlated multi-jittered offsets"),
 }
 # Every comparison sampler of the catalogue (the paper's six, pbrt-v4's zsobol
-# and pmj02), at the count nearest 121, 10 dimensions.
+# and pmj02) and every progressive one (faure, at its default base: b=11 at
+# 121 spp and 10 dims, Bose's array size), at the count nearest 121, 10 dimensions.
 CASES.update({
     f"{n}-{catalogue.nearest_spp(n, 121)}x10": dict(name=n, spp=catalogue.nearest_spp(n, 121), dims=10, offset=None,
                                                     strength=None, about=catalogue.get(n).description)
-    for n in catalogue.names("baseline")
+    for n in (*catalogue.names("baseline"), *catalogue.names("progressive"))
 })
-#: The comparison samplers' cases (``--cases baselines``).
+#: The comparison and progressive samplers' cases (``--cases baselines``).
 BASELINE_CASES = tuple(c for c, spec in CASES.items() if spec["offset"] is None)
 REQUIRED_CASE = "bose-cmj-121x10"
 #: The full set of cases takes about 8 minutes on a 2-core machine (NumPy
@@ -483,7 +484,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                                                                        "baselines": BASELINE_CASES}),
                     default="default",
                     help=f"comma-separated case names, 'default' ({', '.join(DEFAULT_CASES)}), "
-                         "'baselines' (the comparison samplers) or 'all' (see --list; default: default)")
+                         "'baselines' (the comparison and progressive samplers) or 'all' (see --list; "
+                         "default: default)")
     ap.add_argument("--repeats", type=int, default=5, help="timed runs after the warm-up (default: 5)")
     ap.add_argument("--pixels", type=int, default=None,
                     help=f"pixels per generate call (default: {FULL_PIXELS}; {QUICK_PIXELS} with --quick)")
