@@ -83,7 +83,7 @@ from .hashes import MASK, block_seed, hash_pair, permute
 #: Keys of the per-dimension and per-digit seeds (pyoa's choice).
 FAURE_KEY = 0x3C6EF372
 FAURE_DIGIT_KEY = 0xA54FF53A
-FAURE_INDEX_KEY = 0x510E527F
+FAURE_INDEX_KEY = 0x1F83D9AB
 
 #: Largest base: the largest prime ``b`` with ``b**2 <= 2**24``, so that
 #: every base reaches strength 2 within the samplers' limit of ``2**24``.
