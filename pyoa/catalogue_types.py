@@ -228,6 +228,8 @@ class Construction:
     #: whether a pixel's i-th sample is the same for every ``spp``: a stopped
     #: progressive render may continue to a larger count (``--resume``)
     spp_invariant = False
+    #: whether the sampler has a digit base (``base=``; :meth:`with_base`)
+    has_base = False
 
     def __setattr__(self, key, value):
         # One shared instance per sampler name serves every Sampler: changing
@@ -292,7 +294,7 @@ class Construction:
         """``params`` in the digit base ``base``: None for the samplers without
         one (they refuse one), a prime for those with one (``faure``)."""
         if base is not None:
-            having = [c.name for c in REGISTRY.values() if type(c).with_base is not Construction.with_base]
+            having = [c.name for c in REGISTRY.values() if c.has_base]
             raise ValueError(f"{self.name} takes no base (got base={base!r}); only {', '.join(having)} "
                              f"{'has' if len(having) == 1 else 'have'} a digit base")
         return params

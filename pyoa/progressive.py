@@ -36,17 +36,8 @@ from .reference import faure as _reference_faure
 MAX_BASE = _reference_faure.MAX_BASE
 
 
-def _primes_up_to(n: int) -> list[int]:
-    sieve = bytearray([1]) * (n + 1)
-    sieve[:2] = b"\0\0"
-    for k in range(2, math.isqrt(n) + 1):
-        if sieve[k]:
-            sieve[k * k::k] = bytearray(len(sieve[k * k::k]))
-    return [k for k in range(n + 1) if sieve[k]]
-
-
 #: Every valid base, in increasing order.
-BASES = tuple(_primes_up_to(MAX_BASE))
+BASES = _reference_faure.bases()
 
 
 def default_base(spp: int, dims: int | None = None) -> int:
@@ -114,6 +105,7 @@ class Faure(Baseline):
     name = "faure"
     code = 13
     family = "progressive"
+    has_base = True
     progressive = True
     spp_invariant = True
     reference = staticmethod(_reference_faure.faure)

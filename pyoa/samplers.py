@@ -328,7 +328,7 @@ class Sampler:
             _construction=construction, name=construction.name, spp=spp, dims=dims, seed=seed, offset=offset,
             jitter=jitter, params=params, s=params.s, strength=params.strength, block_dims=params.block_dims,
             resolution=params.resolution, n_pixels=construction.pixel_count(params),
-            base=params.s if construction.family == "progressive" else None,
+            base=params.s if construction.has_base else None,
             max_bytes=max_bytes, _backend=impl, _device_selector=device, backend=impl.name,
             device=impl.describe(),
         )

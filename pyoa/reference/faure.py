@@ -77,6 +77,9 @@ References
 
 from __future__ import annotations
 
+import functools
+
+from .. import sequences
 from .baselines import UNIT24, derived_seed
 from .hashes import MASK, block_seed, hash_pair, permute
 
@@ -92,16 +95,11 @@ MAX_BASE = 4093
 MAX_INDEX = 1 << 24
 
 
-def is_prime(n: int) -> bool:
-    """Whether ``n`` is a prime (trial division; ``n`` is small here)."""
-    if n < 2:
-        return False
-    d = 2
-    while d * d <= n:
-        if n % d == 0:
-            return False
-        d += 1
-    return True
+@functools.cache
+def bases() -> tuple[int, ...]:
+    """Every valid base: the primes up to :data:`MAX_BASE`, in increasing order
+    (from :func:`pyoa.sequences.primes`)."""
+    return tuple(int(q) for q in sequences.primes() if q <= MAX_BASE)
 
 
 def out_digits(b: int) -> int:
@@ -175,7 +173,7 @@ def faure(i: int, j: int, b: int, n: int, p: int) -> float:
     p : int
         Seed of the point set (uint32).
     """
-    if not (2 <= b <= MAX_BASE and is_prime(b)):
+    if b not in bases():
         raise ValueError(f"base b must be a prime in [2, {MAX_BASE}], got {b}")
     if not 0 <= i < min(MAX_INDEX, b**n):
         raise ValueError(f"sample index i must be in [0, min(2**24, b**n)), got i={i}, b={b}, n={n}")
