@@ -1,0 +1,114 @@
+"""Integer hashes of docs/spec.md sections 2 and 3 in Dr.Jit operations
+(mirrors :mod:`pyoa._numpy.hashes` and ``kernels/hashes.cl``).
+
+Dr.Jit's ``UInt32`` arithmetic wraps modulo ``2**32`` as the spec requires.
+Constants above ``2**31`` are wrapped in the argument's own type first, so
+that they are never read as signed literals.
+"""
+
+from __future__ import annotations
+
+import drjit as dr
+
+from ..reference.floats import UNIT_SCALE
+from ..reference.hashes import BLOCK_KEY, PIXEL_KEY, walk_mask
+
+
+def mix32(x):
+    """Wellons' lowbias32 (:func:`pyoa.reference.mix32`)."""
+    U = type(x)
+    x = x ^ (x >> 16)
+    x = x * U(0x7FEB352D)
+    x = x ^ (x >> 15)
+    x = x * U(0x846CA68B)
+    return x ^ (x >> 16)
+
+
+def hash_pair(a, b, key: int):
+    """``mix32(b ^ mix32(a ^ key))``, never 0 (:func:`pyoa.reference.hashes.hash_pair`)."""
+    U = type(a) if dr.is_array_v(a) else type(b)
+    a, b = U(a), U(b)
+    h = mix32(b ^ mix32(a ^ U(key)))
+    return dr.select(h == 0, U(key), h)
+
+
+def pixel_seed(seed, pixel):
+    """The point-set seed of one pixel (docs/spec.md section 3)."""
+    return hash_pair(seed, pixel, PIXEL_KEY)
+
+
+def block_seed(p, block):
+    """The seed of block ``block`` (block 0 keeps ``p``; section 6)."""
+    U = type(p) if dr.is_array_v(p) else type(block)
+    p, block = U(p), U(block)
+    return dr.select(block == 0, p, hash_pair(p, block, BLOCK_KEY))
+
+
+def derived_seed(p, index, key: int):
+    """``hash_pair(p, index, key)`` where ``p != 0``, else 0."""
+    U = type(p)
+    return dr.select(p == 0, U(0), hash_pair(p, index, key))
+
+
+def _permute_round(i, p, w: int):
+    """One pass of Kensler's bijection on ``[0, w]`` (the body of the cycle walk)."""
+    U = type(i)
+    W = U(w)
+    i = i ^ p
+    i = i * U(0xE170893D)
+    i = i ^ (p >> 16)
+    i = i ^ ((i & W) >> 4)
+    i = i ^ (p >> 8)
+    i = i * U(0x0929EB3F)
+    i = i ^ (p >> 23)
+    i = i ^ ((i & W) >> 1)
+    i = i * (U(1) | (p >> 27))
+    i = i * U(0x6935FA69)
+    i = i ^ ((i & W) >> 11)
+    i = i * U(0x74DCB303)
+    i = i ^ ((i & W) >> 2)
+    i = i * U(0x9E501CC3)
+    i = i ^ ((i & W) >> 2)
+    i = i * U(0xC860A3DF)
+    i = i & W
+    return i ^ (i >> 5)
+
+
+def permute(i, l: int, p):
+    """Element ``i`` of the ``p``-th permutation of ``0..l-1`` (:func:`pyoa.reference.permute`).
+
+    ``l`` is a Python int (``1 <= l <= 2**31``): it is fixed when the code is
+    traced. The cycle walk is a ``dr.while_loop`` (symbolic inside a traced
+    kernel), left out when ``l`` is a power of two (one round always lands
+    below ``l`` then).
+    """
+    U = type(i) if dr.is_array_v(i) else type(p)
+    i, p = U(i), U(p)
+    if l == 1:
+        return U(0)
+    w = walk_mask(l)
+    x = _permute_round(i, p, w)
+    if w + 1 != l:
+        x = dr.while_loop(state=(x, p), cond=lambda x, p: x >= l,
+                          body=lambda x, p: (_permute_round(x, p, w), p), label="pyoa_permute")[0]
+    L = U(l)
+    return dr.select(p == 0, i, (x + p % L) % L)
+
+
+def randfloat(i, p):
+    """A float32 in ``[0, 1)`` hashed from ``(i, p)`` (:func:`pyoa.reference.randfloat`); 0.5 where ``p == 0``."""
+    U = type(i) if dr.is_array_v(i) else type(p)
+    F = dr.float32_array_t(U)
+    i, p = U(i), U(p)
+    i = i ^ p
+    i = i ^ (i >> 17)
+    i = i ^ (i >> 10)
+    i = i * U(0xB36534E5)
+    i = i ^ (i >> 12)
+    i = i ^ (i >> 21)
+    i = i * U(0x93FC4795)
+    i = i ^ U(0xDF6E307F)
+    i = i ^ (i >> 17)
+    i = i * (U(1) | (p >> 18))
+    # uint32 -> float32 rounds to nearest even, then one float32 multiply
+    return dr.select(p == 0, F(0.5), F(i) * F(UNIT_SCALE))
