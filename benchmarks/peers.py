@@ -78,28 +78,8 @@ def _failure_line(proc: subprocess.CompletedProcess) -> str:
 _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 
 
-#: Mitsuba 3.9's LLVM backend emits llvm.minimum/maximum, which LLVM before 16
-#: cannot lower on x86 ("LLVM ERROR: Cannot select ... fminimum"); Dr.Jit
-#: loads whichever libLLVM it finds first, here Debian's LLVM 14.
-MIN_DRJIT_LLVM = 16
-
-
-def drjit_llvm() -> str | None:
-    """``$DRJIT_LIBLLVM_PATH`` if set, else the newest system libLLVM >= 16
-    (e.g. Debian's ``libllvm19``), else None (Dr.Jit's own search)."""
-    import glob
-    import os
-
-    if os.environ.get("DRJIT_LIBLLVM_PATH"):
-        return os.environ["DRJIT_LIBLLVM_PATH"]
-    found = []
-    for path in glob.glob("/usr/lib/*/libLLVM.so.*") + glob.glob("/usr/lib/*/libLLVM-*.so") \
-            + glob.glob("/usr/lib/llvm-*/lib/libLLVM.so"):
-        m = re.search(r"LLVM(?:\.so\.|-)(\d+)|llvm-(\d+)/", path)
-        major = int(next(g for g in m.groups() if g)) if m else 0
-        if major >= MIN_DRJIT_LLVM:
-            found.append((major, path))
-    return max(found)[1] if found else None
+# Which libLLVM Dr.Jit should load: pyoa's own finder (Mitsuba 3.9 needs LLVM >= 16).
+from pyoa.drjit_llvm import MIN_DRJIT_LLVM, drjit_llvm  # noqa: E402,F401
 
 
 def run_json_script(script: str, args: list, *, timeout: float | None = None, env: dict | None = None) -> dict:

@@ -35,18 +35,25 @@ sample_count : int
     spp=N)`` changes it the same way.
 seed : int
     Added by Mitsuba to the seed of each render (``mi.render(seed=...)``);
-    the sum is pyoa's uint32 seed.
+    the sum modulo ``2**32`` is pyoa's seed.
 offset, jitter, strength, base, dims : str, float, int, int, int
     pyoa's options (:func:`pyoa.sampler`): the OA offset style (``cmj``,
     ``j``, ``mj``, ``centered``), the jitter amount in [0, 1], the strength
     t of ``bush``/``cmjnd``, ``faure``'s prime base, and the number of
     dimensions the integrator uses (only ``cmjnd`` and ``faure`` choose a
     default strength or base from it; 0, the default, leaves it open).
+samples_per_pass : int
+    Only for an integrator that renders in passes (its own
+    ``samples_per_pass``): the same value, a divisor of ``sample_count``.
+    Mitsuba tells a sampler its samples per pass through a C++ method that
+    a Python plugin cannot see, so the plugin must be told; without it a
+    render in passes fails at its second pass (``advance()``) with a message
+    saying this, never with a wrong image. Default: one pass.
 
 The mapping
 -----------
 Mitsuba renders a wavefront of ``P x n`` lanes, ``n = N / passes`` samples
-per pass (``set_samples_per_wavefront``), pixel-major: lane ``l`` is pixel
+per pass (``samples_per_pass`` above), pixel-major: lane ``l`` is pixel
 ``l // n`` and, in pass ``k`` (``advance()`` counts them), sample ``i = k n
 + l % n`` of that pixel, as in Mitsuba's own ``orthogonal`` and
 ``multijitter`` samplers (``Sampler::current_sample_index``). The ``d``-th
@@ -66,16 +73,23 @@ speed. JIT variants (``llvm_*``, ``cuda_*``) only: loading the sampler in a
 
 from __future__ import annotations
 
-import drjit as dr
-import mitsuba as mi
+from .drjit_llvm import configure as _configure_llvm
 
-from . import _drjit
+_configure_llvm()  # before the LLVM backend starts (mi.set_variant('llvm_*')): see pyoa.drjit_llvm
+
+try:
+    import drjit as dr
+    import mitsuba as mi
+except ImportError as exc:  # pragma: no cover - exercised only without mitsuba
+    raise ImportError("pyoa.mitsuba needs Mitsuba 3: pip install 'pyoa[mitsuba]'") from exc
+
+from . import _drjit  # noqa: E402
 from .catalogue_types import MAX_DIMS, MAX_UINT32
 from .samplers import sampler as _pyoa_sampler
 
 #: Every option of the plugin, with its type as Mitsuba's Properties give it.
 OPTIONS = {"sampler": str, "sample_count": int, "seed": int, "offset": str, "jitter": float,
-           "strength": int, "base": int, "dims": int}
+           "strength": int, "base": int, "dims": int, "samples_per_pass": int}
 
 
 def _props(props) -> dict:
@@ -127,14 +141,20 @@ def _make_class(base: type) -> type:
             if not 0 <= self._base_seed <= MAX_UINT32:
                 raise ValueError(f"pyoa sampler: seed must be a uint32 in [0, {MAX_UINT32}], got {self._base_seed}")
             self._configure(self._opts.get("sample_count", 4))
-            self._spw = 1
             self._unseed()
 
         # -- parameters -------------------------------------------------------------------------------
 
         def _configure(self, spp: int) -> None:
             self._pyoa = _resolve(self._opts, spp)
+            per_pass = self._opts.get("samples_per_pass", 0) or spp
+            if per_pass < 1 or spp % per_pass:
+                raise ValueError(f"pyoa sampler: samples_per_pass ({per_pass}) must divide sample_count ({spp})")
             self._spp = spp
+            # Mitsuba's own render loop sets the samples per wavefront through a non-virtual C++ method
+            # that never reaches this class: it is sample_count, or samples_per_pass when given here
+            # (the integrator's samples_per_pass, which must then be the same)
+            self._spw = per_pass
             super().set_sample_count(spp)
 
         def set_sample_count(self, spp: int) -> None:
@@ -144,7 +164,7 @@ def _make_class(base: type) -> type:
             return self._spp
 
         def set_samples_per_wavefront(self, samples_per_wavefront: int) -> None:
-            n = int(samples_per_wavefront)
+            n = int(samples_per_wavefront)  # reached from Python only (see _configure)
             if n < 1 or self._spp % n:
                 raise ValueError(f"pyoa sampler: samples per wavefront ({n}) must divide sample_count ({self._spp})")
             self._spw = n
@@ -160,23 +180,36 @@ def _make_class(base: type) -> type:
         def _unseed(self) -> None:
             self.m_dimension = mi.UInt32(0)
             self.m_pass = mi.UInt32(0)
+            self._passes = 0  # m_pass on the host, to refuse samples past sample_count
             self._pixel_seed = None
             self._lane_sample = None
 
         def seed(self, seed, wavefront_size=MAX_UINT32) -> None:
             super().seed(seed, wavefront_size)
             n = int(wavefront_size)
+            if n >= self._spw and n % self._spw:  # (Mitsuba seeds 1 lane to release memory after a render)
+                raise ValueError(f"pyoa sampler: a wavefront of {n} lanes is not whole pixels of {self._spw} samples: "
+                                 "Mitsuba renders in passes here (the integrator's samples_per_pass, or more than "
+                                 "2^32 samples); give the pyoa sampler the same samples_per_pass")
             lane = dr.arange(mi.UInt32, n)
             s = mi.UInt32(seed) + self._base_seed if dr.is_array_v(seed) else mi.UInt32(int(seed) + self._base_seed)
             self._pixel_seed = _drjit.hashes.pixel_seed(s, lane // self._spw)
             self._lane_sample = lane % self._spw
+            # opaque, as Mitsuba's own counters: one kernel serves every pass
             self.m_dimension = dr.opaque(mi.UInt32, 0)
             self.m_pass = dr.opaque(mi.UInt32, 0)
+            self._passes = 0
 
         def advance(self) -> None:
-            super().advance()
+            # not super().advance(): through nanobind's trampoline it calls this method again
+            if self._spw == self._spp:
+                raise RuntimeError(
+                    f"pyoa sampler: Mitsuba renders in passes (advance() was called), but this sampler was set up "
+                    f"for one pass of {self._spp} samples: give it the integrator's samples_per_pass "
+                    "(<integer name=\"samples_per_pass\" .../> in both), or render in one pass")
             self.m_dimension = dr.opaque(mi.UInt32, 0)
             self.m_pass = self.m_pass + 1
+            self._passes += 1
 
         def schedule_state(self) -> None:
             dr.schedule(self.m_dimension, self.m_pass)
@@ -186,6 +219,7 @@ def _make_class(base: type) -> type:
             other.set_samples_per_wavefront(self._spw)
             other._pixel_seed, other._lane_sample = self._pixel_seed, self._lane_sample
             other.m_dimension, other.m_pass = mi.UInt32(self.m_dimension), mi.UInt32(self.m_pass)
+            other._passes = self._passes
             return other
 
         def fork(self):
@@ -198,6 +232,9 @@ def _make_class(base: type) -> type:
         def next_1d(self, active=True):
             if self._pixel_seed is None:
                 raise RuntimeError("pyoa sampler: seed() the sampler before drawing values")
+            if self._passes * self._spw >= self._spp:
+                raise RuntimeError(f"pyoa sampler: pass {self._passes} of {self._spw} samples is past sample_count "
+                                   f"{self._spp} (advance() was called {self._passes} times since seed())")
             smp = self._pyoa
             entry = smp._construction
             i = self.m_pass * self._spw + self._lane_sample
@@ -213,7 +250,12 @@ def _make_class(base: type) -> type:
             return mi.Point2f(x, y)
 
         def to_string(self) -> str:
-            return f"PyoaSampler[{self._pyoa!r}, samples per wavefront {self._spw}]"
+            smp = self._pyoa
+            c, prm = smp._construction, smp.params
+            detail = c.detail(prm) if hasattr(c, "detail") else f"s={prm.s}, t={prm.strength}"
+            opts = ", ".join(f"{k}={v!r}" for k, v in self._opts.items() if k not in ("sampler", "sample_count"))
+            return (f"PyoaSampler[{smp.name}, sample_count={self._spp}{', ' + opts if opts else ''}"
+                    f"{' (' + detail + ')' if detail else ''}, samples per wavefront {self._spw}]")
 
         def __repr__(self) -> str:
             return self.to_string()
