@@ -83,7 +83,7 @@ try:
 except ImportError as exc:  # pragma: no cover - exercised only without mitsuba
     raise ImportError("pyoa.mitsuba needs Mitsuba 3: pip install 'pyoa[mitsuba]'") from exc
 
-from . import _drjit  # noqa: E402
+from . import _drjit
 from .catalogue_types import MAX_DIMS, MAX_UINT32
 from .samplers import sampler as _pyoa_sampler
 
@@ -95,7 +95,7 @@ OPTIONS = {"sampler": str, "sample_count": int, "seed": int, "offset": str, "jit
 def _props(props) -> dict:
     """The plugin's options from Mitsuba Properties, checked: unknown names and wrong types are refused."""
     out = {}
-    for key in props.keys():
+    for key in props.keys():  # noqa: SIM118 (Mitsuba Properties, not a dict)
         if key in ("id", "type"):
             continue
         if key not in OPTIONS:

@@ -21,8 +21,8 @@ from pyoa.reference.oa import OFFSETS
 from .mitsuba_support import need
 
 _drjit = need("pyoa._drjit")
-import drjit as dr  # noqa: E402
-from drjit.llvm import UInt32  # noqa: E402
+import drjit as dr
+from drjit.llvm import UInt32
 
 SEEDS = (0, 1, 2**32 - 1)
 PIXELS = np.array([0, 1, 7, 2**32 - 1], dtype=np.uint32)

@@ -20,8 +20,8 @@ import pyoa
 from .mitsuba_support import need
 
 pm = need("pyoa.mitsuba")
-import drjit as dr  # noqa: E402
-import mitsuba as mi  # noqa: E402
+import drjit as dr
+import mitsuba as mi
 
 VARIANT = "llvm_ad_rgb"
 

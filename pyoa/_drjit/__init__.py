@@ -31,4 +31,4 @@ try:
 except ImportError as exc:  # pragma: no cover - exercised only without drjit
     raise ImportError("pyoa's Dr.Jit implementation needs drjit (pip install 'pyoa[mitsuba]')") from exc
 
-from .evaluate import SUPPORTED, evaluate, implementation, supports  # noqa: E402,F401
+from .evaluate import SUPPORTED, evaluate, implementation, supports  # noqa: F401

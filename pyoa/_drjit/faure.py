@@ -14,7 +14,13 @@ from __future__ import annotations
 
 import drjit as dr
 
-from ..reference.faure import FAURE_DIGIT_KEY, FAURE_INDEX_KEY, FAURE_KEY, cell_digits, out_digits
+from ..reference.faure import (
+    FAURE_DIGIT_KEY,
+    FAURE_INDEX_KEY,
+    FAURE_KEY,
+    cell_digits,
+    out_digits,
+)
 from .hashes import block_seed, derived_seed, hash_pair, permute
 
 

@@ -12,12 +12,12 @@ check the rest where it matters: against the NumPy backend, bit for bit.
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import drjit as dr
 
 
-@lru_cache(maxsize=None)
+@cache
 def _opaque(F, n: float):
     return dr.opaque(F, n)
 

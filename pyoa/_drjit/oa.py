@@ -10,7 +10,7 @@ code is traced. Values are ``Float32`` arrays of the same backend.
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import drjit as dr
 import numpy as np
@@ -26,7 +26,7 @@ def column_key(p, j, dmax: int):
     return block_seed(p, j // dmax) * (j % dmax + 1)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _table(U, values: tuple) -> object:
     """A read-only device copy of a uint32 table (one per array type and contents)."""
     return U(np.asarray(values, dtype=np.uint32))
@@ -55,7 +55,7 @@ class Field:
         return (a * b) % self.q
 
 
-@lru_cache(maxsize=None)
+@cache
 def field(U, q: int) -> Field:
     return Field(U, q)
 
