@@ -12,6 +12,7 @@ from here; nothing here is timed itself.
 
 from __future__ import annotations
 
+import csv
 import datetime as _dt
 import os
 import platform
@@ -19,8 +20,8 @@ import socket
 import statistics
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -91,7 +92,7 @@ def machine() -> dict:
     except (AttributeError, OSError):
         usable = None
     return {
-        "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "date_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "hostname": socket.gethostname(),
         **_cpu(),
         "cpu_count": os.cpu_count(),
@@ -212,3 +213,28 @@ def write_text(path: Path, text: str) -> None:
         umask = os.umask(0)
         os.umask(umask)
         tmp.chmod(0o666 & ~umask)  # mkstemp creates 0600; results are meant to be shared
+
+
+def write_csv(path: Path, rows: list[dict]) -> None:
+    """``rows`` (dicts with the same keys) as a CSV file, written atomically."""
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
+def replace_section(path: Path, begin: str, end: str, body: str, before: str = "\n---\n") -> None:
+    """Put ``body`` (which starts with ``begin`` and ends with ``end``) into the page ``path``: in place of
+    the text between the markers if the page has them, else before the last ``before`` (a page footer or
+    the heading that follows), else at the end. A study rewrites its own section and nothing else."""
+    page = path.read_text()
+    if begin in page and end in page:
+        a, b = page.index(begin), page.index(end) + len(end)
+        page = page[:a] + body.rstrip("\n") + page[b:]
+    else:
+        cut = page.rfind(before)
+        if cut >= 0:
+            page = page[:cut + 1] + body + "\n" + page[cut + 1:]
+        else:
+            page = page.rstrip("\n") + "\n\n" + body
+    write_text(path, page)

@@ -67,6 +67,9 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+from common import replace_section, write_csv, write_text
 
 import pyoa
 from pyoa import analysis, catalogue
@@ -103,18 +106,6 @@ class Clock:
     def text(self) -> str:
         return (f"{self.wall():.0f} s wall, {time.process_time() - self.c0:.0f} s CPU in this process, 1-minute "
                 f"load average {self.load0:.1f} at the start and {os.getloadavg()[0]:.1f} at the end")
-
-
-def write_text(path: Path, text: str) -> None:
-    with atomic_path(path) as tmp:
-        Path(tmp).write_text(text)
-
-
-def write_csv(path: Path, rows: list[dict]) -> None:
-    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
 
 
 def read_csv(path: Path) -> list[dict]:
@@ -1038,18 +1029,7 @@ def part_section(args, timings: dict) -> None:
         write_text(OUT / "section.md", body)
         print(f"wrote {OUT / 'section.md'} (quick: docs/results.md untouched)")
         return
-    page = RESULTS_MD.read_text()
-    if BEGIN in page and END in page:
-        a = page.index(BEGIN)
-        b = page.index(END) + len(END)
-        page = page[:a] + body.rstrip("\n") + page[b:]
-    else:
-        footer = page.rfind("\n---\n")
-        if footer >= 0:
-            page = page[:footer + 1] + body + "\n" + page[footer + 1:]
-        else:
-            page = page.rstrip("\n") + "\n\n" + body
-    write_text(RESULTS_MD, page)
+    replace_section(RESULTS_MD, BEGIN, END, body)
     print(f"wrote the section into {RESULTS_MD}")
 
 

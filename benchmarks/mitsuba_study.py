@@ -61,7 +61,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import os
@@ -78,6 +77,7 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
 import peers
+from common import replace_section, write_csv, write_text
 
 from pyoa.atomic import atomic_path
 
@@ -133,16 +133,6 @@ def say(*args) -> None:
     print(*args, flush=True)
 
 
-def write_text(path: Path, text: str) -> None:
-    with atomic_path(path) as tmp:
-        Path(tmp).write_text(text, encoding="utf-8")
-
-
-def write_csv(path: Path, rows: list[dict]) -> None:
-    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
 
 
 def write_json(path: Path, obj) -> None:
@@ -673,17 +663,7 @@ def part_section(args) -> None:
         write_text(OUT / "section.md", body)
         say(f"wrote {OUT / 'section.md'} (quick: docs/results.md and docs/performance.md untouched)")
         return
-    page = RESULTS_MD.read_text()
-    if BEGIN in page and END in page:
-        a, b = page.index(BEGIN), page.index(END) + len(END)
-        page = page[:a] + body.rstrip("\n") + page[b:]
-    else:
-        cut = page.rfind("\n---\n")
-        if cut >= 0:
-            page = page[:cut + 1] + body + "\n" + page[cut + 1:]
-        else:
-            page = page.rstrip("\n") + "\n\n" + body
-    write_text(RESULTS_MD, page)
+    replace_section(RESULTS_MD, BEGIN, END, body)
     say(f"wrote the section into {RESULTS_MD}")
     if speed:
         write_performance(speed)
@@ -720,17 +700,7 @@ def write_performance(speed: dict) -> None:
         PERF_END,
         "",
     ])
-    page = PERFORMANCE_MD.read_text()
-    if PERF_BEGIN in page and PERF_END in page:
-        a, b = page.index(PERF_BEGIN), page.index(PERF_END) + len(PERF_END)
-        page = page[:a] + text.rstrip("\n") + page[b:]
-    else:
-        cut = page.find("\n## First use of a shape")
-        if cut >= 0:
-            page = page[:cut + 1] + text + "\n" + page[cut + 1:]
-        else:
-            page = page.rstrip("\n") + "\n\n" + text
-    write_text(PERFORMANCE_MD, page)
+    replace_section(PERFORMANCE_MD, PERF_BEGIN, PERF_END, text, before="\n## First use of a shape")
     say(f"wrote the Mitsuba plugin paragraph into {PERFORMANCE_MD}")
 
 
