@@ -24,7 +24,12 @@ MIN_EXAMPLES = {
     "pyoa.samplers": 5,
     "pyoa.catalogue": 2,
     "pyoa.hashes": 1,
-    "pyoa.analysis": 13,
+    "pyoa.analysis": 7,
+    "pyoa.analysis.pointsets": 4,
+    "pyoa.analysis.integrands": 4,
+    "pyoa.analysis.rates": 2,
+    "pyoa.analysis.spectra": 3,
+    "pyoa.analysis.statistics": 12,
     "pyoa.qmc": 20,
 }
 
