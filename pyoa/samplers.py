@@ -487,6 +487,123 @@ class Sampler:
                 bar.close()
         return out
 
+    def to_dask(self, pixels=None, *, samples=None, dims=None, chunks="auto"):
+        """The values of :meth:`generate` as a lazy Dask array, one :meth:`generate` call per chunk.
+
+        For point sets larger than memory, or wanted where they are used: the
+        array can be written straight to disk (``arr.to_zarr(...)``), kept in
+        a Dask cluster's memory (``arr.persist()``), or reduced chunk by
+        chunk. Each chunk is computed where it is needed, by the worker that
+        needs it: the graph holds only the sampler's parameters (it pickles
+        as them, see :class:`Sampler`) and each chunk's indices, never
+        sample values shipped from the client. A worker process rebuilds the
+        sampler with the same backend name and device selector, so an
+        OpenCL sampler needs OpenCL on the workers.
+
+        Parameters
+        ----------
+        pixels : range or sequence of int, optional
+            Pixel indices, as in :meth:`generate`; default ``[0]``.
+        samples : range or sequence of int, optional
+            Sample indices in ``[0, spp)``; default every sample.
+        dims : range or sequence of int, optional
+            Dimensions in ``[0, dims)``; default every dimension.
+        chunks : int, tuple, dict or "auto"
+            Chunk sizes over the three axes ``(pixels, samples, dims)``, in
+            any form :func:`dask.array.core.normalize_chunks` accepts (``-1``
+            or None for a whole axis; a dict maps an axis to its chunks, the
+            others whole). ``"auto"`` (default): chunks of about Dask's
+            ``array.chunk-size`` (128 MiB unless configured; at most half of
+            ``max_bytes``), each whole ``samples x dims`` rows of a run of
+            pixels where one row fits, else split along samples, then dims.
+
+        Returns
+        -------
+        dask.array.Array
+            float32 of shape ``(len(pixels), len(samples), len(dims))``; every
+            chunk has the bits :meth:`generate` gives for the same indices,
+            whatever the chunking.
+
+        Raises
+        ------
+        ValueError, TypeError
+            At once, not at compute time: the errors :meth:`generate` raises
+            for its index arguments, or a chunk larger than ``max_bytes``
+            (the limit is per chunk; the whole array may be larger).
+        ImportError
+            Dask is not installed.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import pyoa
+        >>> smp = pyoa.sampler("bose", spp=49, dims=8, seed=7, backend="numpy")
+        >>> arr = smp.to_dask(pixels=range(10), chunks=(4, 20, -1))
+        >>> arr.shape, arr.dtype, arr.numblocks
+        ((10, 49, 8), dtype('float32'), (3, 3, 1))
+        >>> bool(np.array_equal(arr.compute(), smp.generate(pixels=range(10))))
+        True
+
+        A billion pixels (196 GB), computed only where a chunk is used; each
+        chunk holds whole ``samples x dims`` rows:
+
+        >>> big = smp.to_dask(pixels=range(10**9))
+        >>> big.shape, big.chunksize[1:]
+        ((1000000000, 49, 8), (49, 8))
+        >>> bool(np.array_equal(big[10**9 - 3:].compute(), smp.generate(pixels=range(10**9 - 3, 10**9))))
+        True
+        """
+        try:
+            import dask
+            import dask.array as da
+            from dask.base import tokenize
+            from dask.highlevelgraph import HighLevelGraph
+            from dask.utils import parse_bytes as dask_bytes
+        except ImportError as exc:
+            raise ImportError('Sampler.to_dask needs Dask: pip install "dask[distributed]"') from exc
+
+        # generate's defaults and index checks, now and in its order (every
+        # argument's kind, then the entries); a range stays a range (a task
+        # gets its slice of it), anything else becomes checked uint32
+        checks = (("pixels", [0] if pixels is None else pixels, self.n_pixels),
+                  ("samples", range(self.spp) if samples is None else samples, self.spp),
+                  ("dims", range(self.dims) if dims is None else dims, self.dims))
+        shape = tuple(_index_length(axis, value, size) for axis, value, size in checks)
+        axes = [value if isinstance(value, range) else _indices(axis, value, size) for axis, value, size in checks]
+
+        if isinstance(chunks, str) and chunks == "auto":
+            limit = min(dask_bytes(dask.config.get("array.chunk-size")), max(self.max_bytes // 2, 1))
+            row = 4 * shape[1] * shape[2]
+            if 0 in shape:  # nothing to split (and Dask's "auto" divides by the row size)
+                chunks = (-1, -1, -1)
+            elif row <= limit:
+                chunks = ("auto", -1, -1)
+            else:
+                chunks = (1, "auto", -1) if 4 * shape[2] <= limit else (1, 1, "auto")
+            chunks = da.core.normalize_chunks(chunks, shape, limit=limit, dtype=np.float32)
+        else:
+            chunks = da.core.normalize_chunks(chunks, shape, dtype=np.float32)
+        largest = [max(c, default=0) for c in chunks]
+        nbytes = 4 * math.prod(largest) + INDEX_BYTES * sum(largest)
+        if nbytes > self.max_bytes:
+            raise ValueError(
+                f"a chunk of {' x '.join(map(str, largest))} float32 values needs {format_bytes(nbytes)} (with its "
+                f"index arrays), over the memory limit of {format_bytes(self.max_bytes)}; ask for smaller chunks, "
+                f"or raise the limit with max_bytes= or ${ENV_MAX_BYTES}"
+            )
+
+        name = f"pyoa-{self.name}-" + tokenize(self.name, self._arguments(), *axes, chunks)
+        parts = []  # per axis: (block number, that block's indices)
+        for value, sizes in zip(axes, chunks):
+            ends = np.cumsum(sizes).tolist()
+            parts.append([(k, value[end - size:end]) for k, (size, end) in enumerate(zip(sizes, ends))])
+        layer = {
+            (name, i, j, k): (_dask_block, self, p, s, d)
+            for i, p in parts[0] for j, s in parts[1] for k, d in parts[2]
+        }
+        graph = HighLevelGraph.from_collections(name, layer, dependencies=())
+        return da.Array(graph, name, chunks, dtype=np.float32, meta=np.empty((0, 0, 0), np.float32))
+
     def value(self, pixel: int, i: int, j: int) -> float:
         """One value, computed by the pure-Python reference.
 
@@ -503,6 +620,11 @@ class Sampler:
 def _rebuild(name: str, arguments: dict) -> Sampler:
     """Unpickle a :class:`Sampler` (see ``Sampler.__reduce__``)."""
     return Sampler(name, **arguments)
+
+
+def _dask_block(smp: Sampler, pixels, samples, dims) -> np.ndarray:
+    """One chunk of :meth:`Sampler.to_dask`: a task of its graph."""
+    return smp.generate(pixels, samples, dims)
 
 
 def _offset(construction, offset):
