@@ -6,6 +6,9 @@
 ``pyoa plot``     every 2D projection of a point set; ``pyoa spectrum`` its power spectrum
 ``pyoa render``   render a scene (EXR/PNG); ``pyoa compare`` tabulate samplers'
                   relative MSE against a reference; ``pyoa reference`` render one
+``pyoa study``    error against spp over seeds, with confidence intervals
+(render, compare, reference and study run on a Dask cluster with
+``--workers N`` or ``--scheduler ADDRESS``; in-process by default)
 """
 
 from __future__ import annotations
@@ -282,8 +285,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_spectrum)
 
     from .render.commands import add_parsers
+    from .study import add_parser as add_study_parser
 
     add_parsers(sub)
+    add_study_parser(sub)
     return ap
 
 
@@ -304,7 +309,7 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning
             return args.func(args)
-    except (ValueError, TypeError, OSError, BackendUnavailable) as exc:
+    except (ValueError, TypeError, OSError, BackendUnavailable) as exc:  # ClusterUnavailable is a ValueError
         # OSError: an output that cannot be written (pyoa.atomic names the
         # user's path), a missing input file; a one-line message, not a traceback
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")

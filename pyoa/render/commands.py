@@ -5,14 +5,14 @@ from __future__ import annotations
 import csv
 import io
 import math
-import sys
 from pathlib import Path
 
-import numpy as np
-
 from .. import catalogue
+from ..analysis.statistics import relmse_noise
 from ..atomic import atomic_path
 from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
+from ..cluster import add_arguments as add_engine_arguments
+from ..cluster import check_engine, engine
 from ..units import format_rate
 from .image import (
     EXR,
@@ -28,9 +28,11 @@ from .image import (
 )
 from .layout import MAX_DEPTH
 from .progressive import check_progressive, render_progressive, state_path
-from .render import SHADINGS, check_memory, plan, render, resolve_shading
+from .reference import reference_key, render_reference, variance_path
+from .reference import state_path as reference_state_path
+from .render import SHADINGS, check_memory, plan, resolve_shading
 from .scene import load
-from .state import BadState, read_state, scene_digest, write_state
+from .tiles import render_on
 
 #: Bytes per pixel that a command allocates besides the render, bounded: the
 #: PNG's float64 sRGB conversion, the reference and the float64 copies of
@@ -78,12 +80,16 @@ def cmd_render(args) -> int:
         raise ValueError(f"{'--time' if args.time is not None else '--resume'} needs --progressive (a render that "
                          "writes its image after every doubling of the samples)")
     if args.progressive:
+        if args.workers is not None or args.scheduler is not None:
+            raise ValueError("--progressive runs in-process (each doubling builds on the last); drop --workers/"
+                             "--scheduler, or render --spp N without --progressive on the cluster")
         check_progressive(args.sampler)
         if args.time is not None and not (math.isfinite(args.time) and args.time > 0):
             raise ValueError(f"--time must be a positive number of seconds, got {args.time}")
     check_output(args.out, "--out", EXR)
     if args.png:
         check_output(args.png, "--png", PNG)
+    check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.spp, base=args.base)
     _check_job_memory(p, f"pyoa render of {p.width} x {p.height} at {p.sampler.spp} spp")
@@ -106,10 +112,10 @@ def cmd_render(args) -> int:
                   f"{pres.samples - pres.resumed_from} samples in {pres.seconds:.2f} s -> {args.out}"
                   f"{' and ' + args.png if args.png else ''} (running sum in {state_path(args.out)})")
     else:
-        res = render(scene, sampler=args.sampler, spp=args.spp, seed=args.seed,
-                     **_size(args),
-                     max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                     shading=args.shading, progress=not args.quiet, base=args.base)
+        with engine(args.workers, args.scheduler) as eng:
+            res = render_on(eng, scene, sampler=args.sampler, spp=args.spp, seed=args.seed, **_size(args),
+                            max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
+                            shading=args.shading, progress=not args.quiet, base=args.base)
         check_finite(res.image, f"--out {args.out!r} not written")  # before either file is written
         write_exr(args.out, res.image)
         if args.png:
@@ -118,7 +124,8 @@ def cmd_render(args) -> int:
         if not args.quiet:
             h, w = res.image.shape[:2]
             print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
-            print(f"{res.seconds:.2f} s, {format_rate(res.paths_per_second)}paths/s, "
+            where = "" if eng.client is None else f" on {eng.description}"
+            print(f"{res.seconds:.2f} s{where}, {format_rate(res.paths_per_second)}paths/s, "
                   f"{format_rate(res.rays_per_second)}rays/s -> {args.out}{' and ' + args.png if args.png else ''}")
     if ref is not None:
         line = f"relMSE {rel_mse(image, ref):.6g}"
@@ -159,22 +166,12 @@ def cmd_compare(args) -> int:
     ref = read_reference(args.reference, "--reference", p.width, p.height)
     crop = args.crop or _default_crop(ref.shape)
     check_crop(crop, p.width, p.height)
+    check_engine(args.workers, args.scheduler)
     rows = []
     crops = []
-    for name, spp in jobs:
-        res = render(scene, sampler=name, spp=spp, seed=args.seed,
-                     **_size(args),
-                     max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                     shading=args.shading, progress=not args.quiet)
-        check_finite(res.image, f"the {name} render ({spp} spp)")  # a NaN relMSE is no answer
-        rows.append(dict(sampler=name, spp=spp, note="" if spp == args.spp else f"nearest valid to {args.spp}",
-                         relmse=rel_mse(res.image, ref), relmse_crop=rel_mse(res.image, ref, crop),
-                         seconds=round(res.seconds, 3)))
-        x, y, w, h = crop
-        crops.append((name, spp, res.image[y:y + h, x:x + w]))
-        if not args.quiet:
-            print(f"{name:12s} {spp:6d} spp  relMSE {rows[-1]['relmse']:.5g}  crop {rows[-1]['relmse_crop']:.5g}  "
-                  f"({res.seconds:.1f} s)")
+    with engine(args.workers, args.scheduler) as eng:
+        for name, spp in jobs:
+            rows.append(_compare_one(eng, scene, args, name, spp, ref, crop, crops))
     md = markdown_table(scene.name, rows, crop)
     print(md)
     with atomic_path(md_path) as tmp:
@@ -190,6 +187,23 @@ def cmd_compare(args) -> int:
     if not args.quiet:
         print(f"-> {md_path}, {csv_path}, {png_path}")
     return 0
+
+
+def _compare_one(eng, scene, args, name: str, spp: int, ref, crop, crops: list) -> dict:
+    """Render one sampler of ``pyoa compare`` on ``eng``: its row, its crop appended to ``crops``."""
+    res = render_on(eng, scene, sampler=name, spp=spp, seed=args.seed, **_size(args), max_depth=args.max_depth,
+                    filter=args.filter, first=args.first, backend=args.backend, shading=args.shading,
+                    progress=not args.quiet)
+    check_finite(res.image, f"the {name} render ({spp} spp)")  # a NaN relMSE is no answer
+    row = dict(sampler=name, spp=spp, note="" if spp == args.spp else f"nearest valid to {args.spp}",
+               relmse=rel_mse(res.image, ref), relmse_crop=rel_mse(res.image, ref, crop),
+               seconds=round(res.seconds, 3))
+    x, y, w, h = crop
+    crops.append((name, spp, res.image[y:y + h, x:x + w]))
+    if not args.quiet:
+        print(f"{name:12s} {spp:6d} spp  relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
+              f"({res.seconds:.1f} s)")
+    return row
 
 
 def _default_crop(shape):
@@ -226,79 +240,13 @@ def crop_figure(path, crops, ref_crop) -> None:
     plt.close(fig)
 
 
-#: Key of the reference passes' seeds (see pass_seed).
-REFERENCE_KEY = 0x52454631
-
-
-def pass_seed(seed: int, k: int) -> int:
-    """Sampler seed of reference pass ``k``: a hash of (seed, k), so that no
-    pass shares its scramble with a render made with a small seed (a
-    reference rendered with seeds 0, 1, ... would share its first samples
-    with ``pyoa compare --seed 0`` and flatter that sampler)."""
-    from ..reference.hashes import hash_pair
-
-    return hash_pair(seed, k, REFERENCE_KEY)
-
-
-#: Version of the state file's layout and key (a state of another version is not resumed).
-STATE_VERSION = 2
-#: Options named when a state's key differs from this run's (key field -> how to say it).
-_KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
-               "width": "--size W", "height": "--size H", "max_depth": "--max-depth", "sampler": "--sampler", "pass_spp": "--pass-spp", "passes": "--spp",
-               "seed": "--seed", "filter": "--filter", "first": "--first", "shading": "--shading"}
-
-
-def _reference_key(scene, args, p, passes: int) -> dict:
-    """Every setting that changes the bits of a reference pass (the backend
-    does not: every backend gives the same samples)."""
-    return dict(version=STATE_VERSION, scene=scene_digest(scene), width=p.width, height=p.height,
-                max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=args.pass_spp, passes=passes,
-                seed=args.seed, filter=args.filter, first=list(p.layout.names),
-                shading=resolve_shading(args.shading))
-
-
-def _describe_change(saved: dict, key: dict) -> str:
-    """Why a saved key is not this run's, as the user would set it: the first field that differs."""
-    for field, option in _KEY_FIELDS.items():
-        if saved.get(field) != key[field]:
-            if field in ("scene", "first", "version"):
-                return f"made with {option}"
-            if field == "passes":  # say it as the user gave it: --spp, the total
-                return f"made with --spp {_total_spp(saved)}, not {_total_spp(key)}"
-            return f"made with {option} {saved.get(field)}, not {key[field]}"
-    return "made with other settings"  # pragma: no cover - keys differ in a field not listed
-
-
-def _total_spp(key: dict):
-    """--spp of a run from its key (passes x pass_spp); "?" for a key without them."""
-    try:
-        return int(key["passes"]) * int(key["pass_spp"])
-    except (KeyError, TypeError, ValueError):
-        return "?"
-
-
-def _resume(state: Path, key: dict, quiet: bool) -> tuple[np.ndarray | None, int]:
-    """The saved sum and pass count to resume from, or (None, 0) to start
-    over, saying why on stderr: a state that is not this run's is never
-    mixed into its mean."""
-    if not state.exists():
-        return None, 0
-    try:
-        total, done = read_state(state, key, "passes", key["passes"], _describe_change)
-    except BadState as why:
-        print(f"pyoa reference: not resuming {state} ({why}): starting over", file=sys.stderr)
-        return None, 0
-    if not quiet:
-        print(f"resuming {state}: {done} of {key['passes']} passes done")
-    return total, done
-
-
 def cmd_reference(args) -> int:
-    """Render a high-spp reference as the mean of passes with independent seeds;
-    after every pass the running sum is saved (``OUT.state.npz``), so an
-    interrupted run resumes where it stopped. A state of other settings, or
-    one that does not hold a valid partial sum, is not resumed: the run
-    starts over and says why."""
+    """Render a high-spp reference as the mean of passes with independent seeds
+    (:mod:`pyoa.render.reference`); after every pass the running sums are
+    saved (``OUT.state.npz``), so an interrupted run resumes where it stopped,
+    in-process or on a cluster. A state of other settings, or one that does
+    not hold a valid partial sum, is not resumed: the run starts over and says
+    why. Besides OUT, writes OUT's per-pixel variance (``NAME.variance.exr``)."""
     _check_counts(args, spp=False)
     check_int("--pass-spp", args.pass_spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
     check_int("--spp", args.spp, 1)
@@ -307,30 +255,30 @@ def cmd_reference(args) -> int:
     passes = args.spp // args.pass_spp
     check_int("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
     check_output(args.out, "--out", EXR)
-    state = Path(str(args.out) + ".state.npz")
+    check_output(variance_path(args.out), "--out (its variance)", EXR)
+    state = reference_state_path(args.out)
     if state.is_dir():
         raise ValueError(f"{str(state)!r} (where pyoa reference keeps its running sum) is a directory; "
                          "remove or rename it")
+    check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.pass_spp)
     _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
-    key = _reference_key(scene, args, p, passes)
-    total, done = _resume(state, key, args.quiet)
-    from tqdm.auto import tqdm
-
-    for k in tqdm(range(done, passes), initial=done, total=passes, desc="reference passes", disable=args.quiet):
-        res = render(scene, sampler=args.sampler, spp=args.pass_spp, seed=pass_seed(args.seed, k),
-                     **_size(args), max_depth=args.max_depth, filter=args.filter, first=args.first,
-                     backend=args.backend, shading=args.shading)
-        # a NaN pass would spoil every later pass's mean: stop at the first
-        check_finite(res.image, f"--out {args.out!r} not written: pass {k}")
-        img = res.image.astype(np.float64)
-        total = img if total is None else total + img
-        write_state(state, total, "passes", k + 1, key)
-    write_exr(args.out, (total / passes).astype(np.float32))
-    state.unlink(missing_ok=True)
+    shading = resolve_shading(args.shading)
+    key = reference_key(scene, p, pass_spp=args.pass_spp, passes=passes, seed=args.seed, filter=args.filter,
+                        shading=shading)
+    kwargs = dict(sampler=args.sampler, spp=args.pass_spp, **_size(args), max_depth=args.max_depth,
+                  filter=args.filter, first=args.first, backend=args.backend, shading=shading)
+    with engine(args.workers, args.scheduler) as eng:
+        _, var = render_reference(eng, scene, out=args.out, key=key, kwargs=kwargs, seed=args.seed,
+                                  quiet=args.quiet)
     if not args.quiet:
-        print(f"reference: {passes} passes x {args.pass_spp} spp -> {args.out}")
+        where = "" if eng.client is None else f" on {eng.description}"
+        print(f"reference: {passes} passes x {args.pass_spp} spp{where} -> {args.out}")
+        if var is not None:
+            ref = read_reference(args.out, "--out", p.width, p.height)
+            print(f"its own noise: relMSE {relmse_noise(var, ref):.3g} (per-pixel variance of the mean -> "
+                  f"{variance_path(args.out)})")
     return 0
 
 
@@ -353,6 +301,7 @@ def add_parsers(sub) -> None:
                        help="numba: compiled shading calling Embree (default); numpy: the NumPy reference "
                             "(default: $PYOA_SHADING, else numba)")
         p.add_argument("-q", "--quiet", action="store_true", help="print nothing but results")
+        add_engine_arguments(p)
 
     p = sub.add_parser("render", help="render a scene with one sampler (EXR, optional PNG)")
     common(p, 16)

@@ -200,6 +200,18 @@ def _sample_range(samples, spp: int) -> range:
     return samples
 
 
+def _pixel_range(pixels, n_pixels: int) -> range:
+    """The checked pixels of a render: every pixel by default, else a
+    non-empty ``range(a, c)`` with step 1 inside ``[0, n_pixels)``."""
+    if pixels is None:
+        return range(n_pixels)
+    if not isinstance(pixels, range) or pixels.step != 1 or not pixels:
+        raise TypeError(f"pixels must be a non-empty range(a, c) with step 1, got {pixels!r}")
+    if pixels.start < 0 or pixels.stop > n_pixels:
+        raise ValueError(f"pixels {pixels} must lie in [0, {n_pixels}) (the image's pixels, row-major)")
+    return pixels
+
+
 class ShadingFallbackWarning(RuntimeWarning):
     """The compiled shading was not usable and the NumPy reference rendered instead."""
 
@@ -222,7 +234,7 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
            backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
            progress: bool = False, shading: str | None = None, max_bytes: int | str | None = None,
            base: int | None = None, samples: range | None = None, sums: np.ndarray | None = None,
-           integrator=None) -> RenderResult:
+           integrator=None, pixels: range | None = None) -> RenderResult:
     """Render ``scene`` (a :class:`pyoa.render.scene.Scene`) with ``spp`` samples per pixel.
 
     Parameters
@@ -274,6 +286,12 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         with the same size, path length, layout and filter, reused instead of
         built again (its setup, and the first call's compilation, are paid
         once: a progressive render's blocks share one).
+    pixels : range, optional
+        Render only these pixels (row-major indices ``y * width + x``, a
+        non-empty ``range(a, c)`` with step 1): the result's ``image`` (and
+        ``sums``) then has shape ``(len(pixels), 3)``, each pixel's value
+        bit-identical to the full render's. A render on a cluster
+        (:mod:`pyoa.render.tiles`) renders its tiles this way.
 
     Raises
     ------
@@ -290,9 +308,11 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     spp, seed = smp.spp, smp.seed
     samples = _sample_range(samples, spp)
     n = len(samples)
+    tile = _pixel_range(pixels, width * height)
+    shape = (height, width, 3) if pixels is None else (len(tile), 3)
     if sums is not None and (not isinstance(sums, np.ndarray) or sums.dtype != np.float64
-                             or sums.shape != (height, width, 3) or not sums.flags.c_contiguous):
-        raise TypeError(f"sums must be a C-contiguous float64 array of shape {(height, width, 3)}")
+                             or sums.shape != shape or not sums.flags.c_contiguous):
+        raise TypeError(f"sums must be a C-contiguous float64 array of shape {shape}")
     integ = None
     if integrator is not None:
         integ, shading = integrator
@@ -312,11 +332,12 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         integ = Integrator(scene, layout, width, height, filter=filter)
     if integrator is None:
         integrator = (integ, shading)
-    n_pixels = width * height
+    n_pixels = len(tile)
     per_batch = max(1, batch_paths // n)
-    batches = [(p0, min(p0 + per_batch, n_pixels)) for p0 in range(0, n_pixels, per_batch)]
+    batches = [(p0, min(p0 + per_batch, tile.stop)) for p0 in range(tile.start, tile.stop, per_batch)]
     out = np.empty((n_pixels, 3), dtype=np.float32)
     flat_sums = None if sums is None else sums.reshape(n_pixels, 3)
+    first = tile.start
     total = Stats()
 
     def run(batch):
@@ -327,9 +348,9 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         rad, st = integ.radiance(pixel, sample, x, seed=seed)
         # per-pixel sum along a contiguous axis: the same bits for any batch size
         s = np.ascontiguousarray(rad.reshape(p1 - p0, n, 3).transpose(0, 2, 1)).sum(axis=2)
-        out[p0:p1] = (s / n).astype(np.float32)
+        out[p0 - first:p1 - first] = (s / n).astype(np.float32)
         if flat_sums is not None:
-            flat_sums[p0:p1] = s
+            flat_sums[p0 - first:p1 - first] = s
         return st
 
     bar = None
@@ -350,6 +371,6 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - t0
-    return RenderResult(image=out.reshape(height, width, 3), sampler=smp.name, spp=n, seed=seed,
+    return RenderResult(image=out.reshape(shape), sampler=smp.name, spp=n, seed=seed,
                         dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total, shading=shading,
                         timings=dict(getattr(integ, "timings", {})), integrator=integrator)

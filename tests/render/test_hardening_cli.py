@@ -231,7 +231,7 @@ def test_scene_nested_100000_deep(pyoa, tmp_path, old_exr):
 ])
 def test_checks_come_before_the_first_render(tmp_path, monkeypatch, capsys, command, argv, pattern):
     from pyoa.cli import main
-    from pyoa.render import commands
+    from pyoa.render import tiles
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "adir.exr").mkdir()
@@ -243,7 +243,7 @@ def test_checks_come_before_the_first_render(tmp_path, monkeypatch, capsys, comm
     def no_render(*args, **kwargs):
         raise AssertionError("rendered before checking its arguments")
 
-    monkeypatch.setattr(commands, "render", no_render)
+    monkeypatch.setattr(tiles, "render", no_render)
     with pytest.raises(SystemExit) as exc:
         main([command, "cornell", "--size", "8", "8", "--spp", "4", *argv, "-q"])
     assert exc.value.code == 2

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from pyoa.cli import main
-from pyoa.render import commands
+from pyoa.render import commands, reference
 from pyoa.render.image import read_image
 from pyoa.render.scene import bundled
 
@@ -43,7 +43,7 @@ def rerun_starts_over(monkeypatch, capsys, argv, out, want, reason):
     capsys.readouterr()
     calls = record_passes(monkeypatch)
     assert main(["reference", *argv]) == 0
-    assert calls == [commands.pass_seed(0, 0), commands.pass_seed(0, 1)]
+    assert calls == [reference.pass_seed(0, 0), reference.pass_seed(0, 1)]
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert err.startswith(f"pyoa reference: not resuming {out}.state.npz (") and err.endswith("): starting over"), err

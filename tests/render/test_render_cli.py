@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from pyoa.cli import main
-from pyoa.render import commands
+from pyoa.render import commands, reference, tiles
 from pyoa.render import image as image_mod
 from pyoa.render.image import read_image, rel_mse, write_exr
 from pyoa.render.render import render
@@ -129,7 +129,7 @@ def test_render_failure_leaves_the_output_untouched(tmp_path, monkeypatch):
     def boom(*args, **kwargs):
         raise RuntimeError("render failed")
 
-    monkeypatch.setattr(commands, "render", boom)
+    monkeypatch.setattr(tiles, "render", boom)
     with pytest.raises(RuntimeError, match="render failed"):
         main(["render", "cornell", "--size", "8", "8", "--spp", "4", "--out", str(out), "--png", str(png), "-q"])
     assert out.read_bytes() == b"previous exr" and png.read_bytes() == b"previous png"
@@ -247,7 +247,7 @@ def test_compare_crop_and_errors(tmp_path, capsys, reference16):
 
 def test_compare_unknown_sampler_renders_nothing(tmp_path, capsys, monkeypatch, reference16):
     calls = []
-    monkeypatch.setattr(commands, "render", lambda *a, **k: calls.append(1))
+    monkeypatch.setattr(tiles, "render", lambda *a, **k: calls.append(1))
     run_error(capsys, ["compare", "cornell", "--samplers", "random,nope", "--reference", str(reference16),
                        "--out", str(tmp_path / "cmp"), "-q"])
     assert calls == []
@@ -265,20 +265,25 @@ def test_reference_is_the_mean_of_passes(tmp_path):
     img = read_image(out)
     assert img.shape == (8, 8, 3)
     sc = load("cornell")
-    seeds = [commands.pass_seed(0, k) for k in (0, 1)]
+    seeds = [reference.pass_seed(0, k) for k in (0, 1)]
     # independent seeds, none of them a small one a render would use
     assert len(set(seeds)) == 2 and min(seeds) > 1000
     passes = [render(sc, sampler="sobol", spp=4, seed=s, width=8, height=8).image.astype(np.float64) for s in seeds]
     np.testing.assert_array_equal(img, ((passes[0] + passes[1]) / 2).astype(np.float32))
-    assert listing(tmp_path) == ["ref.exr"]  # the state file is removed at the end
+    # beside it, the per-pixel variance of the mean: for 2 passes (a - b)^2 / 4
+    var = read_image(tmp_path / "ref.variance.exr")
+    want = ((passes[0] - passes[1]) ** 2 / 4).astype(np.float32)
+    np.testing.assert_allclose(var, want, rtol=1e-6, atol=1e-12)
+    assert var.max() > 0
+    assert listing(tmp_path) == ["ref.exr", "ref.variance.exr"]  # the state file is removed at the end
 
 
-#: commands.render itself, before any test wraps it
-REAL_RENDER = commands.render
+#: tiles.render (what every pass task calls) itself, before any test wraps it
+REAL_RENDER = tiles.render
 
 
 def record_passes(monkeypatch, fail_at=None):
-    """Wrap commands.render (one call per reference pass): record each pass's
+    """Wrap tiles.render (one call per reference pass): record each pass's
     seed, and raise KeyboardInterrupt in call ``fail_at`` (1-based) to
     simulate an interrupted run. Returns the list of seeds."""
     calls = []
@@ -289,7 +294,7 @@ def record_passes(monkeypatch, fail_at=None):
             raise KeyboardInterrupt
         return REAL_RENDER(*args, **kwargs)
 
-    monkeypatch.setattr(commands, "render", wrapped)
+    monkeypatch.setattr(tiles, "render", wrapped)
     return calls
 
 
@@ -303,14 +308,14 @@ def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
     calls = record_passes(monkeypatch, fail_at=2)
     with pytest.raises(KeyboardInterrupt):
         main(["reference", *REF_ARGS, "--out", str(out)])
-    assert calls == [commands.pass_seed(0, 0), commands.pass_seed(0, 1)]
+    assert calls == [reference.pass_seed(0, 0), reference.pass_seed(0, 1)]
     assert state.exists() and not out.exists()
     with np.load(state) as st:
         assert int(st["passes"]) == 1 and st["sum"].shape == (8, 8, 3)
 
     calls = record_passes(monkeypatch)
     assert main(["reference", *REF_ARGS, "--out", str(out)]) == 0
-    assert calls == [commands.pass_seed(0, 1)]  # only the pass that was missing
+    assert calls == [reference.pass_seed(0, 1)]  # only the pass that was missing
     np.testing.assert_array_equal(read_image(out), full)
     assert not state.exists()
 
@@ -323,7 +328,7 @@ def test_reference_ignores_a_state_of_other_settings(tmp_path, monkeypatch, caps
     calls = record_passes(monkeypatch)
     # another seed: the saved pass (of seed 0) is not reused
     assert main(["reference", *REF_ARGS, "--seed", "10", "--out", str(out)]) == 0
-    assert calls == [commands.pass_seed(10, 0), commands.pass_seed(10, 1)]
+    assert calls == [reference.pass_seed(10, 0), reference.pass_seed(10, 1)]
     assert not (tmp_path / "ref.exr.state.npz").exists()
 
 

@@ -1,0 +1,259 @@
+"""Where pyoa's long jobs run: in-process (the default) or on a Dask cluster.
+
+A render, a reference or a study is a list of independent *tasks* (tiles of
+pixels, reference passes, single renders of a study). :func:`engine` gives
+the place they run:
+
+* nothing given: :class:`InProcess`, the tasks run one after another in this
+  process, exactly as a plain ``pyoa render`` always has (no cluster, no
+  extra processes; each task uses every core through the renderer's threads);
+* ``workers=N``: a :class:`distributed.LocalCluster` of N worker processes on
+  this machine, started for the run and closed after it;
+* ``scheduler=ADDRESS`` (or ``$PYOA_SCHEDULER``): an existing Dask cluster,
+  e.g. ``tcp://10.0.0.5:8786`` started with ``dask scheduler`` and
+  ``dask worker ADDRESS`` on several machines (``docs/distributed.md``). An
+  address that does not answer within :data:`CONNECT_TIMEOUT` seconds is a
+  :class:`ClusterUnavailable` error naming it.
+
+Both engines expose :meth:`InProcess.share` (a value many tasks read, sent
+once per worker) and :meth:`InProcess.run`, which yields
+``(index, result)`` as tasks finish. A task is a plain module-level function
+and its arguments; it must not depend on where it runs, which is what makes a
+cluster's results bit-identical to the in-process ones. On a cluster a task
+that loses its worker is run again elsewhere (Dask reschedules it), and a task
+that raises is retried :data:`RETRIES` times before the error reaches the
+caller.
+
+References
+----------
+.. [1] Dask Development Team, "Dask: Library for dynamic task scheduling",
+   https://dask.org (``dask.distributed``: Client, LocalCluster, as_completed).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Callable, Iterable, Iterator, Sequence
+
+from .catalogue_types import check_int
+
+#: Environment variable naming a scheduler to use when ``--scheduler`` is not given.
+ENV_SCHEDULER = "PYOA_SCHEDULER"
+#: Seconds to wait for a scheduler to answer before giving up.
+CONNECT_TIMEOUT = 10
+#: Times a task that raised is run again on a cluster before its error is final.
+RETRIES = 2
+#: Most local worker processes (``--workers``): more than this is a typo.
+MAX_LOCAL_WORKERS = 1024
+
+
+class ClusterUnavailable(ValueError):
+    """No Dask scheduler answered at the address given (the message names it
+    and the timeout, and says how to start one)."""
+
+
+class InProcess:
+    """The embedded default: tasks run here, in order, one at a time."""
+
+    #: Human-readable description (for progress lines and reports).
+    description = "in-process"
+    client = None
+
+    @property
+    def slots(self) -> int:
+        """Tasks that run at once (1: each uses every core through threads)."""
+        return 1
+
+    def task_threads(self) -> int | None:
+        """Renderer threads per task (None: every core)."""
+        return None
+
+    def share(self, value):
+        """``value`` as tasks should receive it: here, the value itself."""
+        return value
+
+    def run(self, fn: Callable, args: Sequence[tuple], *, key: str = "pyoa") -> Iterator[tuple[int, object]]:
+        """Run ``fn(*args[i])`` for every i, yielding ``(i, result)`` in order."""
+        for i, a in enumerate(args):
+            yield i, fn(*a)
+
+    def close(self) -> None:
+        pass
+
+
+class DaskEngine(InProcess):
+    """Tasks on a Dask cluster through a :class:`distributed.Client`."""
+
+    def __init__(self, client, description: str, cluster=None):
+        self.client = client
+        self.cluster = cluster
+        self.description = description
+        self._threads = None
+
+    @property
+    def slots(self) -> int:
+        """Task slots of the cluster: the sum of its workers' threads."""
+        info = self.client.scheduler_info(n_workers=-1) if _takes_n_workers(self.client) else \
+            self.client.scheduler_info()
+        return max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+
+    def task_threads(self) -> int:
+        """Renderer threads per task: each host's cores shared by the task
+        slots of the workers on it (the fewest over hosts), so that a host's
+        tasks together use its cores without oversubscribing them."""
+        if self._threads is None:
+            cores = self.client.run(os.cpu_count)  # {worker address: cores of its host}
+            info = self.client.scheduler_info(n_workers=-1) if _takes_n_workers(self.client) else \
+                self.client.scheduler_info()
+            slots: dict[str, int] = {}
+            host_cores: dict[str, int] = {}
+            for addr, w in info.get("workers", {}).items():
+                host = w.get("host", addr)
+                slots[host] = slots.get(host, 0) + int(w.get("nthreads", 1))
+                host_cores[host] = int(cores.get(addr) or 1)
+            self._threads = max(1, min((host_cores[h] // slots[h] for h in slots), default=1))
+        return self._threads
+
+    def share(self, value):
+        """``value`` sent once to every worker (a Dask future that tasks
+        receive as the value): a scene or a reference image that many tasks
+        read travels once per worker, not once per task."""
+        return self.client.scatter([value], broadcast=True, hash=False)[0]
+
+    def run(self, fn, args, *, key="pyoa"):
+        """Submit every task at once and yield ``(i, result)`` as they finish.
+
+        A task that raised is retried :data:`RETRIES` times; if it still
+        fails, its error is raised here and the tasks not yet finished are
+        cancelled."""
+        from distributed import as_completed
+
+        futures = {}
+        for i, a in enumerate(args):
+            fut = self.client.submit(fn, *a, key=f"{key}-{i}-{_token(fn, a)}", retries=RETRIES, pure=False)
+            futures[fut] = i
+        try:
+            for fut in as_completed(futures, loop=self.client.loop):
+                yield futures[fut], fut.result()
+        finally:
+            self.client.cancel(list(futures))
+
+    def close(self) -> None:
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def _takes_n_workers(client) -> bool:
+    import inspect
+
+    return "n_workers" in inspect.signature(client.scheduler_info).parameters
+
+
+def _token(fn, a) -> str:
+    """A key for the task ``fn(*a)``: unique per call (futures are not hashed by value)."""
+    import uuid
+
+    return f"{fn.__name__}-{uuid.uuid4().hex[:12]}"
+
+
+def resolve_scheduler(scheduler: str | None) -> str | None:
+    """``scheduler``, else ``$PYOA_SCHEDULER``, else None (in-process); an
+    address must be a non-empty string such as ``tcp://host:8786``."""
+    if scheduler is None:
+        scheduler = os.environ.get(ENV_SCHEDULER) or None
+        origin = f"${ENV_SCHEDULER}"
+    else:
+        origin = "--scheduler"
+    if scheduler is None:
+        return None
+    if not isinstance(scheduler, str) or not scheduler.strip():
+        raise ValueError(f"{origin} must be a scheduler address such as tcp://10.0.0.5:8786, got {scheduler!r}")
+    return scheduler.strip()
+
+
+def check_engine(workers: int | None = None, scheduler: str | None = None) -> tuple[int | None, str | None]:
+    """Validate ``workers`` and ``scheduler`` (one at most) without starting anything."""
+    if workers is not None:
+        workers = check_int("--workers", workers, 1, MAX_LOCAL_WORKERS, " (local worker processes)")
+    if workers is not None and scheduler is not None:
+        raise ValueError("give --workers (a local cluster started for this run) or --scheduler (an existing "
+                         "cluster), not both")
+    scheduler = None if workers is not None else resolve_scheduler(scheduler)
+    return workers, scheduler
+
+
+def _connect(address: str, timeout: float):
+    try:
+        from distributed import Client
+    except ImportError as exc:  # pragma: no cover - dask is a dependency
+        raise ImportError('running on a cluster needs Dask: pip install "dask[distributed]"') from exc
+    try:
+        return Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        raise ClusterUnavailable(
+            f"no Dask scheduler answered at {address!r} within {timeout:g} s ({first}); start one with "
+            f"`dask scheduler` and workers with `dask worker {address}`, or run in-process without "
+            f"--scheduler (and unset ${ENV_SCHEDULER})") from None
+
+
+@contextlib.contextmanager
+def engine(workers: int | None = None, scheduler: str | None = None, *,
+           timeout: float = CONNECT_TIMEOUT) -> Iterator[InProcess]:
+    """The engine for a job (see the module docstring), closed on exit.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Start a local cluster of this many worker processes (one thread each).
+    scheduler : str, optional
+        Address of an existing scheduler (default ``$PYOA_SCHEDULER``).
+    timeout : float
+        Seconds to wait for the scheduler (:data:`CONNECT_TIMEOUT`).
+
+    Raises
+    ------
+    ValueError
+        Both given, or a count out of range.
+    ClusterUnavailable
+        Nothing answers at ``scheduler`` within ``timeout`` seconds.
+    """
+    workers, scheduler = check_engine(workers, scheduler)
+    if workers is None and scheduler is None:
+        eng = InProcess()
+    elif workers is not None:
+        from distributed import Client, LocalCluster
+
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        eng = DaskEngine(Client(cluster, set_as_default=False), f"a local cluster of {workers} worker processes",
+                         cluster)
+    else:
+        client = _connect(scheduler, timeout)
+        n = len(client.scheduler_info().get("workers", {}))
+        eng = DaskEngine(client, f"the cluster at {scheduler} ({n} workers)")
+    try:
+        yield eng
+    finally:
+        eng.close()
+
+
+def add_arguments(parser) -> None:
+    """``--workers`` and ``--scheduler`` on a command's parser."""
+    g = parser.add_mutually_exclusive_group()
+    g.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="run on a local Dask cluster of N worker processes started for this run")
+    g.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help=f"run on an existing Dask cluster, e.g. tcp://10.0.0.5:8786 (default ${ENV_SCHEDULER}; "
+                        "neither: in-process)")
+
+
+def progress_over(results: Iterable, total: int, desc: str, quiet: bool, unit: str = "task"):
+    """``results`` with a tqdm bar of ``total`` steps (none when ``quiet``)."""
+    from tqdm.auto import tqdm
+
+    with tqdm(total=total, desc=desc, unit=unit, disable=quiet) as bar:
+        for r in results:
+            yield r
+            bar.update(1)

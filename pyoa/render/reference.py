@@ -1,0 +1,194 @@
+"""High-spp references as the mean of independent passes, resumable, in-process or on a cluster.
+
+A reference of ``passes`` x ``pass_spp`` samples per pixel is the mean of
+``passes`` renders whose sampler seeds are hashes of (seed, pass index)
+(:func:`pass_seed`). Each pass is a task of an engine (:mod:`pyoa.cluster`):
+in-process they run in order; on a cluster they finish in any order. Either
+way the passes join the float64 running sums in pass order (a pass that
+finished early waits, saved, for the ones before it), so the reference has
+the same bits however it was scheduled, and the state file written after
+every finished pass (``OUT.state.npz``, :mod:`.state`) lets a run killed at
+any point resume without rendering a finished pass again.
+
+Besides the mean, the passes give the reference's own noise: the per-pixel
+variance of the mean, ``(S2 - S1^2 / P) / (P - 1) / P`` from the sum ``S1``
+and sum of squares ``S2`` of the P pass images
+(:func:`pyoa.analysis.statistics.pass_variance`), written beside the image
+as ``OUT.variance.exr`` (:func:`variance_path`). A relative MSE measured
+against the reference is too large by about its relMSE-weighted mean
+(:func:`pyoa.analysis.statistics.relmse_noise`); ``pyoa study`` reports and
+corrects for it.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .image import check_finite, write_exr
+from .state import BadState, read_state_arrays, scene_digest, write_state
+from .tiles import worker_render
+
+#: Key of the reference passes' seeds (see pass_seed).
+REFERENCE_KEY = 0x52454631
+#: Version of the state file's layout and key (a state of another version is not resumed).
+STATE_VERSION = 3
+#: Options named when a state's key differs from this run's (key field -> how to say it).
+_KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
+               "width": "--size W", "height": "--size H", "max_depth": "--max-depth", "sampler": "--sampler",
+               "pass_spp": "--pass-spp", "passes": "--spp", "seed": "--seed", "filter": "--filter",
+               "first": "--first", "shading": "--shading"}
+
+
+def pass_seed(seed: int, k: int) -> int:
+    """Sampler seed of reference pass ``k``: a hash of (seed, k), so that no
+    pass shares its scramble with a render made with a small seed (a
+    reference rendered with seeds 0, 1, ... would share its first samples
+    with ``pyoa compare --seed 0`` and flatter that sampler)."""
+    from ..reference.hashes import hash_pair
+
+    return hash_pair(seed, k, REFERENCE_KEY)
+
+
+def variance_path(out) -> Path:
+    """Where the reference ``out`` (``NAME.exr``) keeps its per-pixel variance: ``NAME.variance.exr``."""
+    out = Path(out)
+    return out.with_name(out.name[: -len(out.suffix)] + ".variance.exr" if out.suffix else out.name + ".variance.exr")
+
+
+def state_path(out) -> Path:
+    """Where the reference ``out`` keeps its running sums while it renders: ``OUT.state.npz``."""
+    return Path(str(out) + ".state.npz")
+
+
+def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int, filter: str, shading: str) -> dict:
+    """Every setting that changes the bits of a reference pass (the backend
+    and the engine do not: every backend gives the same samples, every engine
+    the same images)."""
+    return dict(version=STATE_VERSION, scene=scene_digest(scene), width=p.width, height=p.height,
+                max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=pass_spp, passes=passes,
+                seed=seed, filter=filter, first=list(p.layout.names), shading=shading)
+
+
+def _total_spp(key: dict):
+    """--spp of a run from its key (passes x pass_spp); "?" for a key without them."""
+    try:
+        return int(key["passes"]) * int(key["pass_spp"])
+    except (KeyError, TypeError, ValueError):
+        return "?"
+
+
+def describe_change(saved: dict, key: dict) -> str:
+    """Why a saved key is not this run's, as the user would set it: the first field that differs."""
+    for field, option in _KEY_FIELDS.items():
+        if saved.get(field) != key[field]:
+            if field in ("scene", "first", "version"):
+                return f"made with {option}"
+            if field == "passes":  # say it as the user gave it: --spp, the total
+                return f"made with --spp {_total_spp(saved)}, not {_total_spp(key)}"
+            return f"made with {option} {saved.get(field)}, not {key[field]}"
+    return "made with other settings"  # pragma: no cover - keys differ in a field not listed
+
+
+class Passes:
+    """The running sums of a reference's passes, saved after every pass.
+
+    ``add(k, image)`` takes pass k's float32 image in any order; the sums
+    take the passes in order 0, 1, 2, ... (a pass that arrives early is kept,
+    and saved, until the ones before it have arrived).
+    """
+
+    def __init__(self, state: Path, key: dict, *, quiet: bool = False, command: str = "pyoa reference"):
+        self.state, self.key, self.passes = Path(state), key, int(key["passes"])
+        self.shape = (key["height"], key["width"], 3)
+        self.total = self.sumsq = None
+        self.done, self.pending = 0, {}
+        if self.state.exists():
+            try:
+                sums, self.done, self.pending = read_state_arrays(self.state, key, "passes", self.passes,
+                                                                  describe_change, ("sum", "sumsq"), pending=True)
+            except BadState as why:
+                print(f"{command}: not resuming {self.state} ({why}): starting over", file=sys.stderr)
+            else:
+                if self.done:
+                    self.total, self.sumsq = sums["sum"], sums["sumsq"]
+                if not quiet:
+                    extra = f" (and {len(self.pending)} more, out of order)" if self.pending else ""
+                    print(f"resuming {self.state}: {self.done} of {self.passes} passes done{extra}")
+
+    @property
+    def todo(self) -> list[int]:
+        """Passes still to render, in order."""
+        return [k for k in range(self.done, self.passes) if k not in self.pending]
+
+    @property
+    def finished(self) -> int:
+        """Passes rendered so far (in the sums or waiting for them)."""
+        return self.done + len(self.pending)
+
+    def add(self, k: int, image: np.ndarray) -> None:
+        """Take pass ``k``'s image, fold every pass now in order into the sums, save."""
+        self.pending[k] = np.ascontiguousarray(image, dtype=np.float32)
+        while self.done in self.pending:
+            img = self.pending.pop(self.done).astype(np.float64)
+            self.total = img if self.total is None else self.total + img
+            self.sumsq = img * img if self.sumsq is None else self.sumsq + img * img
+            self.done += 1
+        zero = np.zeros(self.shape)
+        order = sorted(self.pending)
+        images = np.stack([self.pending[j] for j in order]) if order else np.zeros((0, *self.shape), np.float32)
+        write_state(self.state, zero if self.total is None else self.total, "passes", self.done, self.key,
+                    sumsq=zero if self.sumsq is None else self.sumsq,
+                    pending=np.asarray(order, dtype=np.int64), images=images)
+
+    def mean(self) -> np.ndarray:
+        """The reference: float32 mean of every pass (all must be done)."""
+        assert self.done == self.passes, (self.done, self.passes)
+        return (self.total / self.passes).astype(np.float32)
+
+    def variance(self) -> np.ndarray | None:
+        """Per-pixel variance of the mean (None with a single pass: no estimate)."""
+        from ..analysis.statistics import pass_variance
+
+        return None if self.passes < 2 else pass_variance(self.total, self.sumsq, self.passes)
+
+
+def pass_task(scene, kwargs: dict, seed: int, k: int, threads: int | None):
+    """One reference pass: ``(k, float32 image)``, checked finite."""
+    res = worker_render(scene, dict(kwargs, seed=pass_seed(seed, k)), threads=threads)
+    # a NaN pass would spoil every later pass's mean: stop at the first
+    check_finite(res.image, f"pass {k}")
+    return k, res.image
+
+
+def render_reference(eng, scene, *, out, key: dict, kwargs: dict, seed: int, quiet: bool = False,
+                     command: str = "pyoa reference") -> tuple[np.ndarray, np.ndarray | None]:
+    """Render (or resume) the reference of ``key`` on the engine ``eng``
+    and write ``out`` and its variance (:func:`variance_path`); returns
+    ``(mean, variance)``. ``kwargs`` are :func:`~pyoa.render.render.render`'s
+    for one pass (the seed aside); every check has been made by the caller."""
+    from tqdm.auto import tqdm
+
+    from .scene_source import source_of
+
+    state = state_path(out)
+    acc = Passes(state, key, quiet=quiet, command=command)
+    todo = acc.todo
+    src = eng.share(scene if eng.client is None else source_of(scene))
+    threads = eng.task_threads()
+    results = eng.run(pass_task, [(src, kwargs, seed, k, threads) for k in todo], key="pyoa-pass")
+    with tqdm(total=acc.passes, initial=acc.finished, desc=f"{Path(out).name} passes", unit="pass",
+              disable=quiet) as bar:
+        for _, (k, image) in results:
+            acc.add(k, image)
+            bar.update(1)
+    mean, var = acc.mean(), acc.variance()
+    write_exr(out, mean)
+    if var is not None:
+        write_exr(variance_path(out), var.astype(np.float32))
+    else:
+        variance_path(out).unlink(missing_ok=True)  # not a stale one of another run
+    state.unlink(missing_ok=True)
+    return mean, var

@@ -1,0 +1,111 @@
+"""Renders split into tasks: tiles of whole pixels, run by an engine (:mod:`pyoa.cluster`).
+
+A render on a cluster is the in-process render cut into tiles of whole pixels
+(every sample of a pixel in one task). Each task loads the scene on its worker
+(:mod:`.scene_source`), generates its own sampler values and returns the
+tile's float32 pixel means; the client only places them. A pixel's value does
+not depend on which other pixels share its batch or its tile (the
+integrator's estimate of a pixel reads only that pixel's samples, and its
+mean is summed along one axis in a fixed order), so the assembled image is
+bit-identical to :func:`pyoa.render.render.render` with the same arguments.
+
+Tasks also run a whole render (:func:`render_task`, one study render) and
+reference passes (:mod:`pyoa.render.reference`); all of them go through
+:func:`worker_render`, which keeps the integrator of a scene and its
+settings per worker process, so its setup and compilation are paid once per
+worker rather than once per task.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .integrator import Stats
+from .render import BATCH_PATHS, RenderResult, plan, render
+from .scene_source import SceneSource, load_source, source_of
+from .state import scene_digest
+
+#: Tiles per task slot of the engine: enough that slots finishing early find work.
+TILES_PER_SLOT = 4
+
+#: Integrators kept in this (worker) process: settings -> RenderResult.integrator.
+_INTEGRATORS: dict[tuple, tuple] = {}
+#: Most integrators kept (a study visits a few scenes and settings).
+_MAX_INTEGRATORS = 16
+
+
+def _integrator_key(digest: str, kwargs: dict) -> tuple:
+    """What an integrator depends on: the scene, film size, path length, layout, filter, shading."""
+    return (digest, kwargs.get("width"), kwargs.get("height"), kwargs.get("max_depth"), kwargs.get("filter"),
+            tuple(kwargs.get("first") or ()), kwargs.get("shading"))
+
+
+def worker_render(src, kwargs: dict, *, pixels: range | None = None, threads: int | None = None) -> RenderResult:
+    """:func:`render` of the scene ``src`` (a :class:`SceneSource` on a
+    worker, the :class:`~pyoa.render.scene.Scene` itself in-process) with
+    ``kwargs`` in this process, reusing this process's integrator for the
+    same scene and settings."""
+    if isinstance(src, SceneSource):
+        scene, digest = load_source(src), src.digest
+    else:
+        scene, digest = src, scene_digest(src)
+    key = _integrator_key(digest, kwargs)
+    res = render(scene, **kwargs, pixels=pixels, threads=threads, integrator=_INTEGRATORS.get(key))
+    if key not in _INTEGRATORS:
+        if len(_INTEGRATORS) >= _MAX_INTEGRATORS:
+            _INTEGRATORS.pop(next(iter(_INTEGRATORS)))
+        _INTEGRATORS[key] = res.integrator
+    res.integrator = None  # it stays on the worker: never pickled back to the client
+    return res
+
+
+def tile_task(src: SceneSource, kwargs: dict, pixels: range, threads: int | None):
+    """One tile: ``(pixels.start, float32 means (len(pixels), 3), Stats)``."""
+    res = worker_render(src, kwargs, pixels=pixels, threads=threads)
+    return pixels.start, res.image, res.stats
+
+
+def tile_ranges(n_pixels: int, spp: int, slots: int) -> list[range]:
+    """Contiguous tiles covering ``[0, n_pixels)``: about
+    :data:`TILES_PER_SLOT` per slot, none smaller than a batch of camera paths
+    (:data:`~pyoa.render.render.BATCH_PATHS`) unless the image is."""
+    smallest = max(1, BATCH_PATHS // max(spp, 1))
+    count = max(1, min(TILES_PER_SLOT * slots, -(-n_pixels // smallest)))
+    size = -(-n_pixels // count)
+    return [range(a, min(a + size, n_pixels)) for a in range(0, n_pixels, size)]
+
+
+def render_on(eng, scene, *, progress: bool = False, **kwargs) -> RenderResult:
+    """Render ``scene`` with :func:`render`'s keyword arguments on the engine
+    ``eng``: in-process, :func:`render` itself; on a cluster, in tiles whose
+    assembled image is bit-identical to it.
+
+    Every argument is checked on the client first (:func:`plan`), before any
+    task is submitted."""
+    if eng.client is None:
+        return render(scene, progress=progress, **kwargs)
+    from .render import resolve_shading
+
+    # the client's shading, not each worker's $PYOA_SHADING: one image
+    kwargs = dict(kwargs, shading=resolve_shading(kwargs.get("shading")))
+    p = plan(scene, **{k: v for k, v in kwargs.items() if k not in ("shading",)})
+    src = source_of(scene)
+    tiles = tile_ranges(p.width * p.height, p.sampler.spp, eng.slots)
+    threads = eng.task_threads()
+    out = np.empty((p.width * p.height, 3), dtype=np.float32)
+    stats = Stats()
+    from ..cluster import progress_over
+
+    t0 = time.perf_counter()
+    src = eng.share(src)
+    results = eng.run(tile_task, [(src, kwargs, t, threads) for t in tiles], key="pyoa-tile")
+    for _, (start, means, st) in progress_over(results, len(tiles), f"{scene.name} {p.sampler.name} "
+                                               f"{p.sampler.spp} spp", not progress, unit="tile"):
+        out[start:start + len(means)] = means
+        stats.add(st)
+    seconds = time.perf_counter() - t0
+    return RenderResult(image=out.reshape(p.height, p.width, 3), sampler=p.sampler.name, spp=p.sampler.spp,
+                        seed=p.sampler.seed, dims=p.layout.dims, layout=p.layout.describe(), seconds=seconds,
+                        stats=stats, shading=kwargs["shading"])
