@@ -74,7 +74,10 @@ class InProcess:
         return value
 
     def run(self, fn: Callable, args: Sequence[tuple], *, key: str = "pyoa") -> Iterator[tuple[int, object]]:
-        """Run ``fn(*args[i])`` for every i, yielding ``(i, result)`` in order."""
+        """Run ``fn(*args[i])`` for every i, yielding ``(i, result)`` in order.
+
+        Callers close the generator (``contextlib.closing``) before the
+        engine, so that an interrupted job's queued tasks are cancelled."""
         for i, a in enumerate(args):
             yield i, fn(*a)
 
@@ -136,8 +139,9 @@ class DaskEngine(InProcess):
         try:
             for fut in as_completed(futures, loop=self.client.loop):
                 yield futures[fut], fut.result()
-        finally:
-            self.client.cancel(list(futures))
+        finally:  # an error or an interruption: the tasks still queued stop
+            if self.client.status == "running":
+                self.client.cancel(list(futures))
 
     def close(self) -> None:
         self.client.close()
@@ -201,7 +205,7 @@ def _connect(address: str, timeout: float):
 
 @contextlib.contextmanager
 def engine(workers: int | None = None, scheduler: str | None = None, *,
-           timeout: float = CONNECT_TIMEOUT) -> Iterator[InProcess]:
+           timeout: float | None = None) -> Iterator[InProcess]:
     """The engine for a job (see the module docstring), closed on exit.
 
     Parameters
@@ -210,8 +214,8 @@ def engine(workers: int | None = None, scheduler: str | None = None, *,
         Start a local cluster of this many worker processes (one thread each).
     scheduler : str, optional
         Address of an existing scheduler (default ``$PYOA_SCHEDULER``).
-    timeout : float
-        Seconds to wait for the scheduler (:data:`CONNECT_TIMEOUT`).
+    timeout : float, optional
+        Seconds to wait for the scheduler (default :data:`CONNECT_TIMEOUT`).
 
     Raises
     ------
@@ -230,7 +234,7 @@ def engine(workers: int | None = None, scheduler: str | None = None, *,
         eng = DaskEngine(Client(cluster, set_as_default=False), f"a local cluster of {workers} worker processes",
                          cluster)
     else:
-        client = _connect(scheduler, timeout)
+        client = _connect(scheduler, CONNECT_TIMEOUT if timeout is None else timeout)
         n = len(client.scheduler_info().get("workers", {}))
         eng = DaskEngine(client, f"the cluster at {scheduler} ({n} workers)")
     try:

@@ -46,6 +46,7 @@ import json
 import math
 import os
 import time
+from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -575,10 +576,10 @@ def run(args) -> int:
         args_list = [(*shared[j.scene], crop, kwargs, j, threads) for j in todo]
         writer = RowWriter(out / "study.csv")
         try:
-            for _, row in progress_over(eng.run(study_task, args_list, key="pyoa-study"), len(todo), "study",
-                                        args.quiet, unit="render"):
-                writer.add(row)
-                rows.append(row)
+            with closing(eng.run(study_task, args_list, key="pyoa-study")) as results:
+                for _, row in progress_over(results, len(todo), "study", args.quiet, unit="render"):
+                    writer.add(row)
+                    rows.append(row)
         finally:
             writer.close()
     seconds = time.perf_counter() - t_start

@@ -23,6 +23,7 @@ corrects for it.
 from __future__ import annotations
 
 import sys
+from contextlib import closing
 from pathlib import Path
 
 import numpy as np
@@ -179,8 +180,8 @@ def render_reference(eng, scene, *, out, key: dict, kwargs: dict, seed: int, qui
     src = eng.share(scene if eng.client is None else source_of(scene))
     threads = eng.task_threads()
     results = eng.run(pass_task, [(src, kwargs, seed, k, threads) for k in todo], key="pyoa-pass")
-    with tqdm(total=acc.passes, initial=acc.finished, desc=f"{Path(out).name} passes", unit="pass",
-              disable=quiet) as bar:
+    with closing(results), tqdm(total=acc.passes, initial=acc.finished, desc=f"{Path(out).name} passes",
+                                unit="pass", disable=quiet) as bar:
         for _, (k, image) in results:
             acc.add(k, image)
             bar.update(1)

@@ -19,6 +19,7 @@ worker rather than once per task.
 from __future__ import annotations
 
 import time
+from contextlib import closing
 
 import numpy as np
 
@@ -100,11 +101,11 @@ def render_on(eng, scene, *, progress: bool = False, **kwargs) -> RenderResult:
 
     t0 = time.perf_counter()
     src = eng.share(src)
-    results = eng.run(tile_task, [(src, kwargs, t, threads) for t in tiles], key="pyoa-tile")
-    for _, (start, means, st) in progress_over(results, len(tiles), f"{scene.name} {p.sampler.name} "
-                                               f"{p.sampler.spp} spp", not progress, unit="tile"):
-        out[start:start + len(means)] = means
-        stats.add(st)
+    with closing(eng.run(tile_task, [(src, kwargs, t, threads) for t in tiles], key="pyoa-tile")) as results:
+        for _, (start, means, st) in progress_over(results, len(tiles), f"{scene.name} {p.sampler.name} "
+                                                   f"{p.sampler.spp} spp", not progress, unit="tile"):
+            out[start:start + len(means)] = means
+            stats.add(st)
     seconds = time.perf_counter() - t0
     return RenderResult(image=out.reshape(p.height, p.width, 3), sampler=p.sampler.name, spp=p.sampler.spp,
                         seed=p.sampler.seed, dims=p.layout.dims, layout=p.layout.describe(), seconds=seconds,
