@@ -561,8 +561,9 @@ def run(args) -> int:
             if old is not None and old != digest and any(r["scene"] == name for r in rows):
                 raise ValueError(f"{out} holds {name} renders measured against another reference; give another "
                                  "--out (or the reference they used)")
-            settings["scenes"][name].update(reference=digest, reference_name=str(path))
             noise[name] = _reference_noise(path, images[name], crop)
+            settings["scenes"][name].update(reference=digest, reference_name=str(path),
+                                            noise=list(noise[name]) if noise[name] else None)
         write_settings(out / "study.json", settings)
         done = {(r["scene"], r["sampler"], r["spp_asked"], r["seed"]) for r in rows}
         todo = [j for j in jobs if j.ident not in done]
@@ -583,6 +584,10 @@ def run(args) -> int:
         finally:
             writer.close()
     seconds = time.perf_counter() - t_start
+    # what each run (the first and every resumption) rendered, where, and how long it took
+    settings.setdefault("runs", []).append(dict(seconds=round(seconds, 1), where=where, rendered=len(todo),
+                                                date=time.strftime("%Y-%m-%dT%H:%M:%S")))
+    write_settings(out / "study.json", settings)
     wanted = {j.ident for j in jobs}
     mine = [r for r in rows if (r["scene"], r["sampler"], r["spp_asked"], r["seed"]) in wanted]
     md = report(settings, mine, noise, samplers=names, seconds=seconds, where=where)
