@@ -25,7 +25,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 
-from pyoa import analysis, catalogue, cli  # noqa: E402
+from pyoa import analysis, catalogue  # noqa: E402
 from pyoa.atomic import atomic_path  # noqa: E402
 from pyoa.plots import error_spectra, projections, spectrum  # noqa: E402
 
@@ -35,7 +35,6 @@ OUT = REPO / "docs" / "results"
 #: power-of-two samplers).
 LINEUP = [(n, catalogue.nearest_spp(n, 121)) for n in ("bose", *catalogue.names("baseline"))]
 #: The padded 2D samplers, which stratify pairs of dimensions only.
-PADDED = ("jittered2d", "cmj2d", "sobol02", "zsobol", "pmj02")
 
 
 #: Convergence cases (integrand, dimensions): smooth and discontinuous, 2 to 10
@@ -200,53 +199,13 @@ def part_error_spectra(page: Page) -> None:
 
 
 def part_renders(page: Page) -> None:
-    page.part("Renders")
-    size = 48 if page.quick else 128
-    ref_spp, pass_spp = (256, 64) if page.quick else (4096, 256)
-    page.add(f"`pyoa compare` at {size} x {size}, 121 spp (128 for the power-of-two samplers), seed 0, against "
-             f"a {ref_spp}-spp reference rendered with `pyoa reference` (hashed pass seeds, so it shares no "
-             "samples with the compared renders). relMSE = mean of (image - ref)^2 / (ref^2 + 0.01).", "")
-    scenes = [("dof7d", "7 dimensions: pixel, lens, time, light (direct lighting, depth of field, motion blur)",
-               (8, 64, 48, 48)),
-              ("bounce9d", "9 dimensions: one bounce of indirect light", None),
-              ("deep", "46 dimensions: up to 11 bounces, glossy and mirror surfaces", None)]
-    for scene, about, crop in scenes:
-        ref = OUT / f"{scene}-reference.exr"
-        if ref.exists() and not page.quick:
-            page.reused.append(scene)
-        else:
-            t = time.perf_counter()
-            cli.main(["reference", scene, "--size", str(size), str(size), "--spp", str(ref_spp),
-                      "--pass-spp", str(pass_spp), "--out", str(ref), "-q"])
-            print(f"   reference {scene}: {time.perf_counter() - t:.0f} s", flush=True)
-        stem = OUT / f"{scene}-121"
-        argv = ["compare", scene, "--size", str(size), str(size), "--spp", "121", "--reference", str(ref),
-                "--samplers", ",".join(n for n, _ in LINEUP), "--out", str(stem), "-q"]
-        if crop and not page.quick:
-            argv += ["--crop", *map(str, crop)]
-        cli.main(argv)
-        page.add(f"### `{scene}`: {about}", "", stem.with_suffix(".md").read_text(), "", _verdict(stem), "",
-                 f"![{scene} crops]({rel(stem.with_suffix('.png'))})", "")
+    """The render tables: a ``pyoa study`` over every sampler, counts and
+    seeds, with intervals (``benchmarks/render_study.py``, which resumes a
+    study already in docs/results/study and can rewrite this section alone)."""
+    import render_study
 
-
-def _verdict(stem: Path) -> str:
-    """One sentence on a compare table, computed from its CSV."""
-    import csv
-
-    with open(stem.with_suffix(".csv")) as fh:
-        rows = {r["sampler"]: float(r["relmse"]) for r in csv.DictReader(fh)}
-    best = min(rows, key=rows.get)
-    padded = min((n for n in PADDED if n in rows), key=rows.get)
-    ratio = rows[padded] / rows["bose"]
-    verdict = "less" if ratio > 1.05 else ("more" if ratio < 0.95 else "about the same")
-    amount = f"{ratio:.2f}x " if verdict == "less" else (f"{1 / ratio:.2f}x " if verdict == "more" else "")
-    than = "as" if verdict == "about the same" else "than"
-    return (f"Whole image: the lowest error is {best}'s ({rows[best]:.4g}); Bose has {amount}{verdict} error "
-            f"{than} the best padded sampler ({padded}, {rows[padded]:.4g}) and {rows['random'] / rows['bose']:.2f}x "
-            "less than random." + "".join(
-                f" Bose against {n}: {rows[n] / rows['bose']:.2f}x "
-                f"({'Bose lower' if rows[n] > rows['bose'] else 'Bose higher'})." for n in ("zsobol", "pmj02")
-                if n in rows))
+    text = render_study.run(quick=page.quick, workers=2, seeds=8)
+    page.add(*text.rstrip("\n").split("\n"), "")
 
 
 def main(argv=None) -> int:

@@ -88,14 +88,13 @@ def section(out: Path, meta: dict) -> str:
     noise = {}
     for name, s in settings["scenes"].items():
         noise[name] = tuple(s["noise"]) if s.get("noise") else None
+    rel = out.relative_to(REPO / "docs") if out.is_relative_to(REPO / "docs") else out
     body = md.split("\n", 2)[2] if md.startswith("# ") else md  # drop the study's own title
     # the study's per-scene headings become this page's subsections
     body = body.replace("\n## ", "\n### ")
     for scene, about in SCENES.items():
-        body = body.replace(f"### {scene}\n", f"### `{scene}`: {about}\n\n![{scene}](results/study/study-{scene}"
-                                               ".png)\n", 1)
+        body = body.replace(f"### {scene}\n", f"### `{scene}`: {about}\n\n![{scene}]({rel}/study-{scene}.png)\n", 1)
     table = cells(rows, noise)
-    rel = out.relative_to(REPO / "docs") if out.is_relative_to(REPO / "docs") else out
     lines = [BEGIN, "## Renders", "",
              f"`pyoa study` (`benchmarks/render_study.py`): {meta['what']} Rows: `{rel}/study.csv` (one per "
              f"render), settings: `{rel}/study.json`. {meta['timing']}", "",
@@ -105,37 +104,42 @@ def section(out: Path, meta: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--quick", action="store_true", help="a small study, printed, not written to the page")
-    ap.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2)")
-    ap.add_argument("--seeds", type=int, default=8)
-    ap.add_argument("--report-only", action="store_true", help="write the page from the saved study")
-    args = ap.parse_args(argv)
-    out = REPO / "docs" / "results" / ("quick/study" if args.quick else "study")
+def run(*, quick: bool = False, workers: int = 2, seeds: int = 8, report_only: bool = False) -> str:
+    """Run (or resume) the study and return the page section."""
+    out = REPO / "docs" / "results" / ("quick/study" if quick else "study")
     out.parent.mkdir(parents=True, exist_ok=True)
-    scenes = ["dof7d", "cornell"] if args.quick else list(SCENES)
-    size, spp, ref_spp = ("16", "16,64", "1024") if args.quick else ("64", "16,64,256,1024", "16384")
-    seeds = "3" if args.quick else str(args.seeds)
-    argv_ = ["study", *scenes, "--samplers", "all", "--spp", spp, "--seeds", seeds, "--reference-spp", ref_spp,
-             "--size", size, size, "--out", str(out), "-q"]
-    if args.workers > 0:
-        argv_ += ["--workers", str(args.workers)]
-    if not args.report_only:
-        rc = cli.main(argv_)
+    scenes = ["dof7d", "cornell"] if quick else list(SCENES)
+    size, spp, ref_spp = ("16", "16,64", "1024") if quick else ("64", "16,64,256,1024", "16384")
+    seeds_ = "3" if quick else str(seeds)
+    argv = ["study", *scenes, "--samplers", "all", "--spp", spp, "--seeds", seeds_, "--reference-spp", ref_spp,
+            "--size", size, size, "--out", str(out), "-q"]
+    if workers > 0:
+        argv += ["--workers", str(workers)]
+    if not report_only:
+        rc = cli.main(argv)
         if rc:
-            return rc
+            raise SystemExit(rc)
     settings = json.loads((out / "study.json").read_text())
     runs = settings.get("runs", [])
     meta = machine()
-    what = (f"{len(scenes)} scenes at {size} x {size}, every sampler, spp {spp}, {seeds} seeds, references of "
+    what = (f"{len(scenes)} scenes at {size} x {size}, every sampler, spp {spp}, {seeds_} seeds, references of "
             f"{ref_spp} spp made by `pyoa reference` passes on the same cluster; command "
-            f"`pyoa {' '.join(argv_[:-1])}`.")
+            f"`pyoa {' '.join(a for a in argv if a != '-q').replace(str(REPO) + '/', '')}`.")
     spent = sum(r["seconds"] for r in runs)
     where = "; ".join(sorted({r["where"] for r in runs if r["rendered"]})) or "?"
     when = (f"The study (references included) took {spent / 60:.1f} minutes in {len(runs)} run(s) on {where}, "
             f"{meta['cpu']} ({meta['cpu_count']} cores).")
-    text = section(out, {"what": what, "timing": when})
+    return section(out, {"what": what, "timing": when})
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="a small study, printed, not written to the page")
+    ap.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2; 0: in-process)")
+    ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--report-only", action="store_true", help="write the section from the saved study")
+    args = ap.parse_args(argv)
+    text = run(quick=args.quick, workers=args.workers, seeds=args.seeds, report_only=args.report_only)
     if args.quick:
         print(text)
     else:

@@ -60,8 +60,9 @@ from .catalogue_types import MAX_SPP, MAX_UINT32, check_int
 #: Samplers of a study by default: the paper's table (random, the padded 2D
 #: samplers, bose, and the high-dimensional halton and sobol).
 DEFAULT_SAMPLERS = ("random", "jittered2d", "cmj2d", "sobol02", "bose", "halton", "sobol")
-#: Samplers that stratify pairs of dimensions and pad them (the paper's "(pad)").
-PADDED = ("jittered2d", "cmj2d", "sobol02", "pmj02")
+#: Samplers that stratify pairs of dimensions and pad them (the paper's "(pad)";
+#: pbrt-v4's zsobol and pmj02 pad their pairs the same way, docs/samplers.md).
+PADDED = ("jittered2d", "cmj2d", "sobol02", "zsobol", "pmj02")
 #: Columns of study.csv.
 FIELDS = ("scene", "sampler", "spp_asked", "spp", "seed", "relmse", "relmse_crop", "mse", "seconds")
 #: Version of study.json (a study of another version is not resumed).
@@ -562,7 +563,8 @@ def run(args) -> int:
                 raise ValueError(f"{out} holds {name} renders measured against another reference; give another "
                                  "--out (or the reference they used)")
             noise[name] = _reference_noise(path, images[name], crop)
-            settings["scenes"][name].update(reference=digest, reference_name=str(path),
+            shown = path.name if path.resolve().parent == out.resolve() else str(path)  # DIR's own: its name
+            settings["scenes"][name].update(reference=digest, reference_name=shown,
                                             noise=list(noise[name]) if noise[name] else None)
         write_settings(out / "study.json", settings)
         done = {(r["scene"], r["sampler"], r["spp_asked"], r["seed"]) for r in rows}
