@@ -352,3 +352,41 @@ def test_bad_output_or_reference_fails_before_any_task(tmp_path, capsys, monkeyp
         main([command, "cornell", "--size", "8", "8", "--spp", "16", *extra, "--scheduler", scheduler, "-q"])
     assert exc.value.code == 2
     assert match in capsys.readouterr().err
+
+
+def test_a_scene_file_with_a_mesh_is_sent_to_the_workers(tmp_path, scheduler):
+    """A scene outside the package, with a mesh in a sibling folder: the
+    workers load it from the bytes the client sends (no shared files), and
+    render the in-process image."""
+    import json
+    from pyoa.render.scene import bundled
+    from pyoa.render.scene_source import source_of
+
+    from .render.test_scene import OBJ
+
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "pyramid.obj").write_text(OBJ)
+    (tmp_path / "scenes").mkdir()
+    data = json.loads(open(bundled()["cornell"]).read())
+    data["shapes"].append({"type": "mesh", "file": "../meshes/pyramid.obj", "material": data["shapes"][0]["material"],
+                           "to_world": [[0.5, 0, 0, -0.2], [0, 0.5, 0, -1], [0, 0, 0.5, 0.3], [0, 0, 0, 1]]})
+    path = tmp_path / "scenes" / "room.json"
+    path.write_text(json.dumps(data))
+    sc = load(str(path))
+    src = source_of(sc)
+    assert src.name is None and sorted(rel for rel, _ in src.files) == ["meshes/pyramid.obj", "scenes/room.json"]
+    kw = dict(sampler="bose", spp=16, seed=2, width=12, height=10)
+    want = render(sc, **kw).image
+    with cluster.engine(scheduler=scheduler) as eng:
+        got = render_on(eng, sc, **kw).image
+        # each worker loaded the scene from the bytes it was sent, in its own folder
+        paths = eng.client.run(_loaded_paths)
+    np.testing.assert_array_equal(bits(got), bits(want))
+    loaded = [p for ps in paths.values() for p in ps if p.endswith("room.json")]
+    assert loaded and all("pyoa-scenes-" in p and not p.startswith(str(tmp_path)) for p in loaded), paths
+
+
+def _loaded_paths():
+    from pyoa.render import scene_source
+
+    return [s.path for s in scene_source._LOADED.values()]
