@@ -26,6 +26,7 @@ from .atomic import atomic_path, check_writable
 from .backends import BackendUnavailable, PyoaFallbackWarning
 from .catalogue import get
 from .catalogue_types import MAX_UINT32, SppChoice, check_int
+from .cluster import TasksLost
 from .samplers import trial_options
 from .units import format_rate
 
@@ -309,7 +310,7 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning
             return args.func(args)
-    except (ValueError, TypeError, OSError, BackendUnavailable) as exc:  # ClusterUnavailable is a ValueError
+    except (ValueError, TypeError, OSError, BackendUnavailable, TasksLost) as exc:  # ClusterUnavailable: ValueError
         # OSError: an output that cannot be written (pyoa.atomic names the
         # user's path), a missing input file; a one-line message, not a traceback
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")

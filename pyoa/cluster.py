@@ -53,6 +53,11 @@ class ClusterUnavailable(ValueError):
     and the timeout, and says how to start one)."""
 
 
+class TasksLost(RuntimeError):
+    """A task whose workers kept dying (Dask's ``KilledWorker``: each time it
+    ran, its worker process was lost, e.g. killed for using too much memory)."""
+
+
 class InProcess:
     """The embedded default: tasks run here, in order, one at a time."""
 
@@ -130,7 +135,7 @@ class DaskEngine(InProcess):
         A task that raised is retried :data:`RETRIES` times; if it still
         fails, its error is raised here and the tasks not yet finished are
         cancelled."""
-        from distributed import as_completed
+        from distributed import KilledWorker, as_completed
 
         futures = {}
         for i, a in enumerate(args):
@@ -138,7 +143,13 @@ class DaskEngine(InProcess):
             futures[fut] = i
         try:
             for fut in as_completed(futures, loop=self.client.loop):
-                yield futures[fut], fut.result()
+                try:
+                    result = fut.result()
+                except KilledWorker as exc:
+                    raise TasksLost(f"task {futures[fut]} of {len(futures)} lost its worker every time it ran "
+                                    f"({exc}); a worker process that dies on one task (memory?) is not retried "
+                                    "forever: check the workers' logs") from None
+                yield futures[fut], result
         finally:  # an error or an interruption: the tasks still queued stop
             if self.client.status == "running":
                 self.client.cancel(list(futures))

@@ -359,6 +359,7 @@ def test_a_scene_file_with_a_mesh_is_sent_to_the_workers(tmp_path, scheduler):
     workers load it from the bytes the client sends (no shared files), and
     render the in-process image."""
     import json
+
     from pyoa.render.scene import bundled
     from pyoa.render.scene_source import source_of
 
@@ -390,3 +391,51 @@ def _loaded_paths():
     from pyoa.render import scene_source
 
     return [s.path for s in scene_source._LOADED.values()]
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["render", "cornell", "--progressive", "--sampler", "faure", "--workers", "2", "--out", "{tmp}/p.exr"],
+     "--progressive runs in-process"),
+    (["study", "dof7d", "cornell", "--reference", "{tmp}/a.exr", "--out", "{tmp}/o"],
+     "--reference gives 1 image(s) for 2 scene(s)"),
+    (["study", "dof7d", "--reference", "{tmp}/a.exr", "--reference-spp", "64", "--out", "{tmp}/o"], "not both"),
+    (["study", "dof7d", "--out", "{tmp}/o"], "a study needs references"),
+    (["study", "dof7d", "--reference-spp", "64", "--spp", "16,x", "--out", "{tmp}/o"], "'x' is not an integer"),
+    (["study", "dof7d", "--reference-spp", "64", "--seeds", "0", "--out", "{tmp}/o"], "--seeds must be"),
+])
+def test_refusals_before_anything_starts(tmp_path, capsys, monkeypatch, argv, match):
+    def no_engine(*a, **k):
+        raise AssertionError("an engine was started")
+
+    monkeypatch.setattr(cluster, "engine", no_engine)
+    with pytest.raises(SystemExit) as exc:
+        main([a.format(tmp=tmp_path) for a in argv] + ["-q"])
+    assert exc.value.code == 2
+    assert match in capsys.readouterr().err
+
+
+def test_a_csv_that_is_not_a_study_is_refused(inprocess_study, tmp_path, capsys):
+    import shutil
+
+    from pyoa.study import FIELDS
+
+    out = tmp_path / "copy"
+    shutil.copytree(inprocess_study, out)
+    (out / "study.csv").write_text("a,b,c\n1,2,3\n")
+    with pytest.raises(SystemExit):
+        main(["study", *STUDY, "--out", str(out)])
+    assert "is not a pyoa study's CSV" in capsys.readouterr().err
+    (out / "study.csv").write_text(",".join(FIELDS) + "\ndof7d,bose,16,16,0,x,1,1,1\n")
+    with pytest.raises(SystemExit):
+        main(["study", *STUDY, "--out", str(out)])
+    assert "a row that is not a study's" in capsys.readouterr().err
+
+
+def test_a_worker_refuses_a_scene_that_is_not_the_clients():
+    from dataclasses import replace
+
+    from pyoa.render import scene_source
+
+    src = scene_source.source_of(load("cornell"))
+    with pytest.raises(ValueError, match="is not the client's"):
+        scene_source.load_source(replace(src, digest="0" * 64))

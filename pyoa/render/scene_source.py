@@ -91,7 +91,7 @@ def load_source(src: SceneSource) -> Scene:
         scene = load(root / src.main)
     got = scene_digest(scene)
     if got != src.digest:
-        raise RuntimeError(f"scene {src.label!r} on this worker is not the client's (digest {got[:12]} vs "
+        raise ValueError(f"scene {src.label!r} on this worker is not the client's (digest {got[:12]} vs "
                            f"{src.digest[:12]}): install the same pyoa version on every machine")
     _LOADED[src.digest] = scene
     return scene
