@@ -171,7 +171,7 @@ def check_settings(path: Path, settings: dict) -> dict:
                     raise ValueError(f"{path.parent} holds {name} renders made with {say}; give another --out")
             s = {**old, **{k: v for k, v in s.items() if v is not None}}
         scenes[name] = s
-    return {**settings, "scenes": scenes}
+    return {**settings, "scenes": scenes, "runs": list(saved.get("runs") or [])}
 
 
 def write_settings(path: Path, settings: dict) -> None:
@@ -336,8 +336,11 @@ def headline(table: dict) -> list[str]:
 
 def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=None, seconds=None,
            where: str = "") -> str:
-    """The Markdown report of a study (see the module docstring)."""
+    """The Markdown report of a study (see the module docstring); ``seconds``
+    the time of every run so far (``settings["runs"]``)."""
     table = cells(rows, noise)
+    n_runs = len(settings.get("runs", []))
+    runs = f" ({n_runs} runs: the first and its resumptions)" if n_runs > 1 else ""
     w, h = settings["size"]
     x, y, cw, ch = settings["crop"]
     lines = ["# Sampler study", "",
@@ -345,8 +348,8 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
              "(image - ref)^2 / (ref^2 + 0.01) (the paper's measure). Each cell: the mean over seeds of the relMSE "
              "minus the reference's own noise estimate, ± the half-width of its 95 % Student-t interval over "
              "seeds. The slope is the least-squares fit of log(mean) against log(spp)." +
-             (f" Rendered {where}." if where else "") +
-             (f" This run took {seconds:.0f} s." if seconds is not None else ""), ""]
+             (f" Rendered {where if where == 'in-process' else 'on ' + where}." if where else "") +
+             (f" It took {seconds:.0f} s in all{runs}." if seconds is not None else ""), ""]
     for scene, by_sampler in table.items():
         s = settings["scenes"].get(scene, {})
         nz = noise.get(scene)
@@ -404,6 +407,11 @@ def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
     rows_ = -(-len(scenes) // cols)
     fig = Figure(figsize=(6.0 * cols, 4.6 * rows_), dpi=100, layout="constrained")
     FigureCanvasAgg(fig)
+    # one colour per sampler, the same in every panel (tab10 repeats after 10)
+    from matplotlib import colormaps
+
+    colours = colormaps["tab20"].colors
+    colour = {n: colours[(2 * k) % 20 + (2 * k) // 20 % 2] for k, n in enumerate(samplers)}
     for i, scene in enumerate(scenes):
         ax = fig.add_subplot(rows_, cols, i + 1)
         for name in samplers:
@@ -419,7 +427,7 @@ def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
             if not keep.any():
                 continue
             sl = slope(by)
-            (line,) = ax.loglog(n[keep], m[keep], marker="o", ms=3, lw=1.2,
+            (line,) = ax.loglog(n[keep], m[keep], marker="o", ms=3, lw=1.2, color=colour[name],
                                 label=f"{name} ({sl:.2f})" if math.isfinite(sl) else name,
                                 ls="-" if name not in PADDED else "--")
             band = keep & np.isfinite(lo) & (lo > 0)
@@ -592,7 +600,8 @@ def run(args) -> int:
     write_settings(out / "study.json", settings)
     wanted = {j.ident for j in jobs}
     mine = [r for r in rows if (r["scene"], r["sampler"], r["spp_asked"], r["seed"]) in wanted]
-    md = report(settings, mine, noise, samplers=names, seconds=seconds, where=where)
+    md = report(settings, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in settings["runs"]),
+                where=where)
     with atomic_path(out / "study.md") as tmp:
         tmp.write_text(md)
     table = cells(mine, noise)

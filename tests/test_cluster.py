@@ -272,6 +272,14 @@ def test_an_interrupted_study_resumes_and_renders_only_what_is_missing(inprocess
     assert main(["study", *STUDY, "--out", str(out)]) == 0
     assert len(rendered) == 16 - 5
     assert rows_of(out / "study.csv") == rows_of(inprocess_study / "study.csv")
+    # a run with nothing left renders nothing, and study.json keeps every finished run's time
+    rendered.clear()
+    assert main(["study", *STUDY, "--out", str(out)]) == 0
+    import json
+
+    runs = json.loads((out / "study.json").read_text())["runs"]
+    assert rendered == [] and [r["rendered"] for r in runs] == [11, 0]
+    assert "in all (2 runs" in (out / "study.md").read_text()
 
 
 def test_a_killed_worker_costs_only_its_task(inprocess_study, tmp_path):
