@@ -223,6 +223,20 @@ def write_csv(path: Path, rows: list[dict]) -> None:
         w.writerows(rows)
 
 
+def publish_section(page: Path, begin: str, end: str, body: str, *, quick_dir: Path | None = None,
+                    say: Callable[[str], None] = print, untouched: str = "docs/results.md") -> bool:
+    """A study's section: into ``page`` (:func:`replace_section`), or, for a
+    quick run (``quick_dir`` given), into ``quick_dir/section.md`` with the
+    page left alone. Returns whether the page was written."""
+    if quick_dir is not None:
+        write_text(quick_dir / "section.md", body)
+        say(f"wrote {quick_dir / 'section.md'} (quick: {untouched} untouched)")
+        return False
+    replace_section(page, begin, end, body)
+    say(f"wrote the section into {page}")
+    return True
+
+
 def replace_section(path: Path, begin: str, end: str, body: str, before: str = "\n---\n") -> None:
     """Put ``body`` (which starts with ``begin`` and ends with ``end``) into the page ``path``: in place of
     the text between the markers if the page has them, else before the last ``before`` (a page footer or

@@ -69,7 +69,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
-from common import replace_section, write_csv, write_text
+from common import publish_section, write_csv, write_text
 
 import pyoa
 from pyoa import analysis, catalogue
@@ -1025,12 +1025,7 @@ def part_section(args, timings: dict) -> None:
              "what that buys and costs.")
     body = "\n".join([BEGIN, "## faure: progressive orthogonal arrays", "", intro, "", INTERPRETATION, *parts,
                       footer, END, ""])
-    if args.quick:
-        write_text(OUT / "section.md", body)
-        print(f"wrote {OUT / 'section.md'} (quick: docs/results.md untouched)")
-        return
-    replace_section(RESULTS_MD, BEGIN, END, body)
-    print(f"wrote the section into {RESULTS_MD}")
+    publish_section(RESULTS_MD, BEGIN, END, body, quick_dir=OUT if args.quick else None)
 
 
 def main(argv=None) -> int:

@@ -77,7 +77,7 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
 import peers
-from common import replace_section, write_csv, write_text
+from common import publish_section, replace_section, write_csv, write_text
 
 from pyoa.atomic import atomic_path
 
@@ -659,12 +659,9 @@ def part_section(args) -> None:
               "section` rewrites this section from the saved files in `docs/results/mitsuba/`).")
     body = "\n".join([BEGIN, "## pyoa inside Mitsuba 3", "", intro, "", interpretation(speed, errors), "",
                       *parts, fig, footer, END, ""])
-    if args.quick:
-        write_text(OUT / "section.md", body)
-        say(f"wrote {OUT / 'section.md'} (quick: docs/results.md and docs/performance.md untouched)")
+    if not publish_section(RESULTS_MD, BEGIN, END, body, quick_dir=OUT if args.quick else None, say=say,
+                           untouched="docs/results.md and docs/performance.md"):
         return
-    replace_section(RESULTS_MD, BEGIN, END, body)
-    say(f"wrote the section into {RESULTS_MD}")
     if speed:
         write_performance(speed)
 

@@ -102,9 +102,15 @@ class DaskEngine(InProcess):
     @property
     def slots(self) -> int:
         """Task slots of the cluster: the sum of its workers' threads."""
-        info = self.client.scheduler_info(n_workers=-1) if _takes_n_workers(self.client) else \
-            self.client.scheduler_info()
-        return max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+        return max(1, sum(w.get("nthreads", 1) for w in self._workers().values()))
+
+    def _workers(self) -> dict:
+        """Every worker's entry of the scheduler's info (newer Dask lists only
+        the first few unless asked for all)."""
+        import inspect
+
+        every = {"n_workers": -1} if "n_workers" in inspect.signature(self.client.scheduler_info).parameters else {}
+        return self.client.scheduler_info(**every).get("workers", {})
 
     def task_threads(self) -> int:
         """Renderer threads per task: each host's cores shared by the task
@@ -112,11 +118,9 @@ class DaskEngine(InProcess):
         tasks together use its cores without oversubscribing them."""
         if self._threads is None:
             cores = self.client.run(os.cpu_count)  # {worker address: cores of its host}
-            info = self.client.scheduler_info(n_workers=-1) if _takes_n_workers(self.client) else \
-                self.client.scheduler_info()
             slots: dict[str, int] = {}
             host_cores: dict[str, int] = {}
-            for addr, w in info.get("workers", {}).items():
+            for addr, w in self._workers().items():
                 host = w.get("host", addr)
                 slots[host] = slots.get(host, 0) + int(w.get("nthreads", 1))
                 host_cores[host] = int(cores.get(addr) or 1)
@@ -158,12 +162,6 @@ class DaskEngine(InProcess):
         self.client.close()
         if self.cluster is not None:
             self.cluster.close()
-
-
-def _takes_n_workers(client) -> bool:
-    import inspect
-
-    return "n_workers" in inspect.signature(client.scheduler_info).parameters
 
 
 def _token(fn, a) -> str:
@@ -246,8 +244,8 @@ def engine(workers: int | None = None, scheduler: str | None = None, *,
                          cluster)
     else:
         client = _connect(scheduler, CONNECT_TIMEOUT if timeout is None else timeout)
-        n = len(client.scheduler_info().get("workers", {}))
-        eng = DaskEngine(client, f"the cluster at {scheduler} ({n} workers)")
+        eng = DaskEngine(client, f"the cluster at {scheduler}")
+        eng.description += f" ({len(eng._workers())} workers)"
     try:
         yield eng
     finally:

@@ -466,11 +466,11 @@ def run(args) -> int:
     from .render.commands import _check_job_memory, _default_crop
     from .render.image import EXR, check_crop, check_output, read_reference
     from .render.reference import reference_key, render_reference
-    from .render.reference import state_path as reference_state
     from .render.render import plan, resolve_shading
     from .render.scene import load
     from .render.scene_source import source_of
     from .render.state import scene_digest
+    from .render.state import state_path as reference_state
 
     t_start = time.perf_counter()
     scenes_arg = list(dict.fromkeys(args.scenes))
@@ -502,8 +502,9 @@ def run(args) -> int:
     out = check_out_dir(args.out)
     shading = resolve_shading(args.shading)
     size = dict(width=args.size[0], height=args.size[1]) if args.size else dict(width=None, height=None)
-    common = dict(**size, max_depth=args.max_depth, filter=args.filter, first=None, backend=args.backend,
-                  shading=shading)
+    # plan() takes every render setting but the shading
+    planned = dict(**size, max_depth=args.max_depth, filter=args.filter, first=None, backend=args.backend)
+    common = dict(planned, shading=shading)
     # every check a long job could fail at its end, on the client, before any task
     loaded, jobs, refs = {}, [], {}
     dims = None
@@ -517,8 +518,7 @@ def run(args) -> int:
                 n = catalogue.nearest_spp(name, asked)
                 if n is None:
                     raise ValueError(f"{name} has no valid sample count near {asked}")
-                p = plan(scene, sampler=name, spp=n, seed=seed0, **{k: v for k, v in common.items()
-                                                                     if k != "shading"})
+                p = plan(scene, sampler=name, spp=n, seed=seed0, **planned)
                 _check_job_memory(p, f"a {scene.name} render with {name} at {n} spp")
                 dims = (p.width, p.height)
                 jobs += [Job(scene.name, name, asked, n, seed0 + k) for k in range(seeds)]
@@ -553,8 +553,7 @@ def run(args) -> int:
                          and saved.get("reference_spp") == args.reference_spp)
                 if not fresh:
                     passes = args.reference_spp // pass_spp
-                    p = plan(scene, sampler="sobol", spp=pass_spp, seed=0,
-                             **{k: v for k, v in common.items() if k != "shading"})
+                    p = plan(scene, sampler="sobol", spp=pass_spp, seed=0, **planned)
                     key = reference_key(scene, p, pass_spp=pass_spp, passes=passes, seed=0, filter=args.filter,
                                         shading=shading)
                     kwargs = dict(sampler="sobol", spp=pass_spp, **common)

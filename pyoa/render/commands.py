@@ -29,7 +29,6 @@ from .image import (
 from .layout import MAX_DEPTH
 from .progressive import check_progressive, render_progressive, state_path
 from .reference import reference_key, render_reference, variance_path
-from .reference import state_path as reference_state_path
 from .render import SHADINGS, check_memory, plan, resolve_shading
 from .scene import load
 from .tiles import render_on
@@ -256,7 +255,7 @@ def cmd_reference(args) -> int:
     check_int("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
     check_output(args.out, "--out", EXR)
     check_output(variance_path(args.out), "--out (its variance)", EXR)
-    state = reference_state_path(args.out)
+    state = state_path(args.out)
     if state.is_dir():
         raise ValueError(f"{str(state)!r} (where pyoa reference keeps its running sum) is a directory; "
                          "remove or rename it")

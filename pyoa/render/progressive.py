@@ -37,7 +37,6 @@ import math
 import sys
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -45,7 +44,14 @@ from .. import catalogue
 from .image import check_finite, write_exr, write_png
 from .integrator import Stats
 from .render import plan, render, resolve_shading
-from .state import BadState, read_state, saved_key, scene_digest, write_state
+from .state import (
+    BadState,
+    read_state,
+    saved_key,
+    scene_digest,
+    state_path,
+    write_state,
+)
 
 #: Version of the progressive state's layout and key.
 STATE_VERSION = 1
@@ -72,11 +78,6 @@ def block_ends(done: int, spp: int) -> list[int]:
             ends.append(k)
         k *= 2
     return ends + ([spp] if spp > done else [])
-
-
-def state_path(out) -> Path:
-    """Where a progressive render to ``out`` keeps its running sum."""
-    return Path(str(out) + ".state.npz")
 
 
 def check_progressive(name: str) -> None:

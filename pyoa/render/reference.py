@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .image import check_finite, write_exr
-from .state import BadState, read_state_arrays, scene_digest, write_state
+from .state import BadState, read_state_arrays, scene_digest, state_path, write_state
 from .tiles import worker_render
 
 #: Key of the reference passes' seeds (see pass_seed).
@@ -57,11 +57,6 @@ def variance_path(out) -> Path:
     """Where the reference ``out`` (``NAME.exr``) keeps its per-pixel variance: ``NAME.variance.exr``."""
     out = Path(out)
     return out.with_name(out.name[: -len(out.suffix)] + ".variance.exr" if out.suffix else out.name + ".variance.exr")
-
-
-def state_path(out) -> Path:
-    """Where the reference ``out`` keeps its running sums while it renders: ``OUT.state.npz``."""
-    return Path(str(out) + ".state.npz")
 
 
 def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int, filter: str, shading: str) -> dict:

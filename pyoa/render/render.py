@@ -188,28 +188,17 @@ def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: 
     return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit)
 
 
-def _sample_range(samples, spp: int) -> range:
-    """The checked sample range of a render: ``range(spp)`` by default, else
-    a non-empty ``range(a, c)`` with step 1 inside ``[0, spp)``."""
-    if samples is None:
-        return range(spp)
-    if not isinstance(samples, range) or samples.step != 1 or not samples:
-        raise TypeError(f"samples must be a non-empty range(a, c) with step 1, got {samples!r}")
-    if samples.start < 0 or samples.stop > spp:
-        raise ValueError(f"samples {samples} must lie in [0, {spp}) (the sampler's spp)")
-    return samples
-
-
-def _pixel_range(pixels, n_pixels: int) -> range:
-    """The checked pixels of a render: every pixel by default, else a
-    non-empty ``range(a, c)`` with step 1 inside ``[0, n_pixels)``."""
-    if pixels is None:
-        return range(n_pixels)
-    if not isinstance(pixels, range) or pixels.step != 1 or not pixels:
-        raise TypeError(f"pixels must be a non-empty range(a, c) with step 1, got {pixels!r}")
-    if pixels.start < 0 or pixels.stop > n_pixels:
-        raise ValueError(f"pixels {pixels} must lie in [0, {n_pixels}) (the image's pixels, row-major)")
-    return pixels
+def _sub_range(name: str, r, n: int, what: str) -> range:
+    """``r`` checked as a non-empty ``range(a, c)`` with step 1 inside
+    ``[0, n)`` (``what`` says what ``n`` counts); None means ``range(n)``.
+    The samples and the pixels of a render are chosen this way."""
+    if r is None:
+        return range(n)
+    if not isinstance(r, range) or r.step != 1 or not r:
+        raise TypeError(f"{name} must be a non-empty range(a, c) with step 1, got {r!r}")
+    if r.start < 0 or r.stop > n:
+        raise ValueError(f"{name} {r} must lie in [0, {n}) ({what})")
+    return r
 
 
 class ShadingFallbackWarning(RuntimeWarning):
@@ -306,9 +295,9 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
              max_bytes=max_bytes, base=base)
     width, height, layout, smp = p.width, p.height, p.layout, p.sampler
     spp, seed = smp.spp, smp.seed
-    samples = _sample_range(samples, spp)
+    samples = _sub_range("samples", samples, spp, "the sampler's spp")
     n = len(samples)
-    tile = _pixel_range(pixels, width * height)
+    tile = _sub_range("pixels", pixels, width * height, "the image's pixels, row-major")
     shape = (height, width, 3) if pixels is None else (len(tile), 3)
     if sums is not None and (not isinstance(sums, np.ndarray) or sums.dtype != np.float64
                              or sums.shape != shape or not sums.flags.c_contiguous):

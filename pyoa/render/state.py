@@ -24,6 +24,12 @@ import numpy as np
 from ..atomic import atomic_path
 
 
+def state_path(out) -> Path:
+    """Where a long render to ``out`` (a reference, a progressive render)
+    keeps its running sums while it works: ``OUT.state.npz``."""
+    return Path(str(out) + ".state.npz")
+
+
 class BadState(Exception):
     """A state file that cannot be resumed (the message says why)."""
 

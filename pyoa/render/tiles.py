@@ -19,6 +19,7 @@ worker rather than once per task.
 from __future__ import annotations
 
 import time
+import weakref
 from contextlib import closing
 
 import numpy as np
@@ -33,6 +34,8 @@ TILES_PER_SLOT = 4
 
 #: Integrators kept in this (worker) process: settings -> RenderResult.integrator.
 _INTEGRATORS: dict[tuple, tuple] = {}
+#: Digests of the Scene objects rendered in this process (freed with them).
+_DIGESTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 #: Most integrators kept (a study visits a few scenes and settings).
 _MAX_INTEGRATORS = 16
 
@@ -50,8 +53,8 @@ def worker_render(src, kwargs: dict, *, pixels: range | None = None, threads: in
     same scene and settings."""
     if isinstance(src, SceneSource):
         scene, digest = load_source(src), src.digest
-    else:
-        scene, digest = src, scene_digest(src)
+    else:  # in-process: the Scene itself, hashed once (a study renders it hundreds of times)
+        scene, digest = src, _DIGESTS.get(src) or _DIGESTS.setdefault(src, scene_digest(src))
     key = _integrator_key(digest, kwargs)
     res = render(scene, **kwargs, pixels=pixels, threads=threads, integrator=_INTEGRATORS.get(key))
     if key not in _INTEGRATORS:
@@ -91,7 +94,7 @@ def render_on(eng, scene, *, progress: bool = False, **kwargs) -> RenderResult:
 
     # the client's shading, not each worker's $PYOA_SHADING: one image
     kwargs = dict(kwargs, shading=resolve_shading(kwargs.get("shading")))
-    p = plan(scene, **{k: v for k, v in kwargs.items() if k not in ("shading",)})
+    p = plan(scene, **{k: v for k, v in kwargs.items() if k != "shading"})
     src = source_of(scene)
     tiles = tile_ranges(p.width * p.height, p.sampler.spp, eng.slots)
     threads = eng.task_threads()
