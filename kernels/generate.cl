@@ -48,10 +48,11 @@ uint rect_index(uint out0, uint k, uint pl, uint d, uint n_k, uint n_dims)
     uint i = samples[k], j = dims[d], pixel = pixels[pl];                               \
     uint p = pixel_seed(seed, pixel)
 
-/* The value of construction `construction` (its CONSTRUCTION_* code):
- * generated from the catalogue (pyoa._opencl.program.dispatch_source). */
-float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint p, uint offset, float J,
-               __global const ushort *gf, uint gf_tabled, __global const uint *consts);
+/* The value of construction `construction` (its CONSTRUCTION_* code) with B
+ * columns per block, N rows and M sub-strata: generated from the catalogue
+ * (pyoa._opencl.program.dispatch_source). */
+float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint B, uint N, uint M, uint p,
+                  uint offset, float J, __global const ushort *gf, uint gf_tabled, __global const uint *consts);
 
 /* The direct path: any offset, everything from scratch (permute's cycle walk
  * keeps this kernel scalar on PoCL). */
@@ -60,6 +61,9 @@ __kernel void generate(RECT_ARGS,
                        const uint construction,
                        const uint s,
                        const uint t,
+                       const uint B,
+                       const uint N,
+                       const uint M,
                        const uint offset,
                        const float J,
                        __global const ushort *gf,
@@ -67,8 +71,8 @@ __kernel void generate(RECT_ARGS,
                        __global const uint *consts)
 {
     RECT_PRELUDE;
-    out[rect_index(out0, k, pl, d, n_k, n_dims)] = oa_dispatch(construction, i, j, s, t, p, offset, J,
-                                                            gf, gf_tabled, consts);
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = oa_dispatch(construction, i, j, s, t, B, N, M, p, offset, J,
+                                                               gf, gf_tabled, consts);
 }
 
 /* The table path, in two launches over a rectangle of pixels x samples
@@ -182,6 +186,55 @@ __kernel void NAME(__global float *restrict out,                                
  * docs/performance.md). 'centered' passes cell_u = 0 and never reads it. */
 GENERATE_CELLS(generate_cells, sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s))
 GENERATE_CELLS(generate_cells_centered, centered_value(stratum, jit, M, s))
+
+/* The table path of requests with dimensions past block 0 (docs/spec.md
+ * section 6): a later block reads its copy at its own rows, so its cells
+ * depend on the pixel. `rows` holds the row of every sample position per
+ * slot: slot 0 (offset 0) the sample indices themselves (block 0, shared by
+ * every pixel), then one slot per (pixel, block >= 1) filled by block_rows;
+ * ro[pd] is the offset of (pixel, dimension) pd's slot. cell_a and cell_u
+ * hold the cells of every row of the array in each requested dimension's
+ * column ([d][row], pyoa.host_tables.array_cells), so one gather serves both. */
+#define GENERATE_ROWS(NAME, VALUE)                                                      \
+__kernel void NAME(__global float *restrict out,                                        \
+                   const uint out0,                                                     \
+                   __global const uint *restrict tab,                                   \
+                   __global const uint *restrict cell_a,                                \
+                   __global const uint *restrict cell_u,                                \
+                   __global const uint *restrict rows,                                  \
+                   __global const uint *restrict ro,                                    \
+                   const uint n_k,                                                      \
+                   const uint n_dims,                                                   \
+                   const uint E,                                                        \
+                   const uint Es,                                                       \
+                   const uint s,                                                        \
+                   const uint M,                                                        \
+                   const uint N,                                                        \
+                   const float J)                                                       \
+{                                                                                       \
+    uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                      \
+    uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;                             \
+    uint row = rows[ro[pd] + k], c = d * N + row;                                       \
+    uint stratum = tab[base + cell_a[c]];                                               \
+    float jit = jitter_value(randfloat(row, tab[base + E - 1u]), J);                    \
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = VALUE;                               \
+}
+
+GENERATE_ROWS(generate_rows, sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s))
+GENERATE_ROWS(generate_rows_centered, centered_value(stratum, jit, M, s))
+
+/* The rows of the later blocks' slots: axis 0 the sample position k, axis 1
+ * the slot m - 1 (slot m = 1 + pixel * blocks + block index), whose order
+ * seed is orders[m - 1] (never 0). permute's cycle walk keeps this kernel
+ * scalar on PoCL, but it runs once per (pixel, block, sample), not per value. */
+__kernel void block_rows(__global uint *restrict rows,
+                         __global const uint *restrict orders,
+                         const uint n_k,
+                         const uint N)
+{
+    uint k = (uint)get_global_id(0), m = (uint)get_global_id(1) + 1u;
+    rows[m * n_k + k] = block_row(rows[k], N, orders[m - 1u]);
+}
 
 /* The comparison samplers: one kernel each, one work-item per value, over a
  * rectangle like `generate`. a, b and c are the sampler's shape arguments

@@ -5,7 +5,7 @@
  * pragma opens this file and program.source() puts it first in the program. */
 #pragma OPENCL FP_CONTRACT OFF
 
-/* STRATUM_KEY, SUBSTRATUM_KEY, JITTER_KEY, PIXEL_KEY and BLOCK_KEY are not
+/* STRATUM_KEY, SUBSTRATUM_KEY, JITTER_KEY, PIXEL_KEY, BLOCK_KEY and BLOCK_ORDER_KEY are not
  * defined here: pyoa/_opencl/program.py's defines() passes them as -D build
  * options (uint literals), generated from the constants of the same names in
  * pyoa/reference/hashes.py, their only definition. */
@@ -23,6 +23,9 @@
 #endif
 #ifndef BLOCK_KEY
 #error "BLOCK_KEY undefined: build with pyoa._opencl.program.defines()"
+#endif
+#ifndef BLOCK_ORDER_KEY
+#error "BLOCK_ORDER_KEY undefined: build with pyoa._opencl.program.defines()"
 #endif
 
 /* One pass of Kensler's bijection on [0, w] (the body of the cycle walk).
@@ -109,3 +112,12 @@ uint hash_pair(uint a, uint b, uint key)
 uint pixel_seed(uint seed, uint pixel) { return hash_pair(seed, pixel, PIXEL_KEY); }
 
 uint block_seed(uint p, uint block) { return block ? hash_pair(p, block, BLOCK_KEY) : p; }
+
+/* The seed of block `block`'s sample order (docs/spec.md section 6): 0 for
+ * block 0 (permute with seed 0 is the identity), else never 0. */
+uint block_order_seed(uint P, uint block, uint N) { return block ? hash_pair(P, N, BLOCK_ORDER_KEY) : 0u; }
+
+/* The row of sample i in a block whose order seed is r: two permutations
+ * with independent seeds (pyoa.reference.hashes.block_row says why), the
+ * identity for r = 0. */
+uint block_row(uint i, uint N, uint r) { return permute(permute(i, N, r), N, mix32(r)); }

@@ -1,15 +1,22 @@
 /* Orthogonal-array samplers of docs/spec.md section 5 (mirrors pyoa/reference/oa.py).
  * Offset codes OFFSET_* come from pyoa.constructions as -D build options.
  *
- * Each sampler is split into the pieces the bulk kernels of generate.cl
- * reuse: the column key (block seed times column + 1, docs/spec.md sections 3 and 6),
- * the integer cell of the array, and the final value. */
+ * A value is the block rule (oa_locate: the copy's seed, the row and the
+ * column), a construction's cell of (row, column) (the *_cell functions,
+ * the only part a construction supplies) and one shared tail (oa_tail).
+ * oa_dispatch, generated from the catalogue after generate.cl
+ * (pyoa._opencl.program.dispatch_source), puts the three together. */
 
-/* q = block_seed(p, j / dmax) * (j % dmax + 1): the three dimension seeds are
- * q * STRATUM_KEY, q * SUBSTRATUM_KEY and q * JITTER_KEY. */
-uint column_key(uint p, uint j, uint dmax)
+/* The block rule (docs/spec.md section 6): dimension j of sample i reads
+ * column j % B of copy j / B, with seed P = block_seed(p, j / B), at row
+ * block_row(i, N, block_order_seed(P, j / B, N)): row i in block 0, the
+ * copy's own order of the rows in later blocks. */
+void oa_locate(uint p, uint i, uint j, uint B, uint N, uint *P, uint *row, uint *col)
 {
-    return block_seed(p, j / dmax) * (j % dmax + 1u);
+    uint block = j / B;
+    *col = j % B;
+    *P = block_seed(p, block);
+    *row = block_row(i, N, block_order_seed(*P, block, N));
 }
 
 /* Bose over GF(s): A_ij of column j (< s+1) and A_ik of its partner column
@@ -48,7 +55,8 @@ void cmjnd_cell(uint i, uint s, uint sj, uint *aij, uint *v)
     *v = i % sj + (i / (sj * s)) * sj;
 }
 
-/* x from the stratum, the integer sub-stratum and the jitter seed. */
+/* x from the stratum, the integer sub-stratum and the jitter seed (row: the
+ * jitter's randfloat index). */
 float oa_value(uint i, uint stratum, uint sub, uint P3, uint M, uint s, float J, uint offset)
 {
     float jit = jitter_value(randfloat(i, P3), J);
@@ -65,44 +73,12 @@ uint offset_sub(uint offset, uint u, uint M, uint cell_key, uint aij, uint P2)
     return permute(u, M, seed);
 }
 
-float bose(uint i, uint j, uint s, uint p, uint offset, float J, __global const ushort *gf, uint tabled)
-{
-    uint q = column_key(p, j, s + 1u);
-    uint aij, aik;
-    bose_cell(i, j % (s + 1u), s, gf, tabled, &aij, &aik);
-    uint stratum = permute(aij, s, q * STRATUM_KEY);
-    uint sub = offset_sub(offset, aik, s, aik * s + aij + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, s, s, J, offset);
-}
-
 /* pow_u(s, e) = s^e; every use stays below 2^24. */
 uint pow_u(uint s, uint e)
 {
     uint r = 1u;
     for (uint k = 0u; k < e; ++k) r *= s;
     return r;
-}
-
-float cmjnd(uint i, uint j, uint s, uint t, uint p, uint offset, float J)
-{
-    uint q = column_key(p, j, t);
-    uint M = pow_u(s, t - 1u);
-    uint aij, v;
-    cmjnd_cell(i, s, pow_u(s, j % t), &aij, &v);
-    uint stratum = permute(aij, s, q * STRATUM_KEY);
-    uint sub = offset_sub(offset, v, M, i + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J, offset);
-}
-
-float bush(uint i, uint j, uint s, uint t, uint p, uint offset, float J, __global const ushort *gf, uint tabled)
-{
-    uint q = column_key(p, j, s + 1u);
-    uint M = pow_u(s, t - 1u);
-    uint aij, u;
-    bush_cell(i, j % (s + 1u), s, t, M, gf, tabled, &aij, &u);
-    uint stratum = permute(aij, s, q * STRATUM_KEY);
-    uint sub = offset_sub(offset, u, M, i + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, M, s, J, offset);
 }
 
 /* Addelman-Kempthorne: A_ij of column j < 2q+1 and the sub-stratum index u
@@ -136,27 +112,13 @@ void bose_bush_cell(uint i, uint j, uint s, __global const ushort *gf, uint tabl
     *u = (j < 2u * s) ? x : (x / s) * s + k;
 }
 
-/* The index-2 constructions share M = 2s, 2s+1 columns and the 'j' seed i+1. */
-float index2_value(uint i, uint j, uint s, uint aij, uint u, uint q, uint offset, float J)
+/* The common tail (docs/spec.md section 5.2): x of row `row` in column `col`
+ * of the copy with seed P, from the construction's cell (A_ij, u) and the
+ * 'j' offset's cell key. */
+float oa_tail(uint row, uint col, uint P, uint aij, uint u, uint cell_key, uint s, uint M, uint offset, float J)
 {
+    uint q = P * (col + 1u);  /* times the three keys: the column's seeds (section 3.3) */
     uint stratum = permute(aij, s, q * STRATUM_KEY);
-    uint sub = offset_sub(offset, u, 2u * s, i + 1u, aij, q * SUBSTRATUM_KEY);
-    return oa_value(i, stratum, sub, q * JITTER_KEY, 2u * s, s, J, offset);
-}
-
-float addelman_kempthorne(uint i, uint j, uint s, uint p, uint offset, float J,
-                          __global const ushort *gf, uint tabled, __global const uint *ak)
-{
-    uint q = column_key(p, j, 2u * s + 1u);
-    uint aij, u;
-    addelman_kempthorne_cell(i, j % (2u * s + 1u), s, gf, tabled, ak, &aij, &u);
-    return index2_value(i, j, s, aij, u, q, offset, J);
-}
-
-float bose_bush(uint i, uint j, uint s, uint p, uint offset, float J, __global const ushort *gf, uint tabled)
-{
-    uint q = column_key(p, j, 2u * s + 1u);
-    uint aij, u;
-    bose_bush_cell(i, j % (2u * s + 1u), s, gf, tabled, &aij, &u);
-    return index2_value(i, j, s, aij, u, q, offset, J);
+    uint sub = offset_sub(offset, u, M, cell_key, aij, q * SUBSTRATUM_KEY);
+    return oa_value(row, stratum, sub, q * JITTER_KEY, M, s, J, offset);
 }

@@ -8,6 +8,8 @@
  *   VND, VNK        dimensions and sample positions of the request
  *   VNKP            VNK rounded up to whole blocks of 8
  *   VDMAX           dimensions per block (docs/spec.md section 6)
+ *   VN, VWN         rows N = s M of the array and the walk mask of N
+ *   VLATER          1: some dimension lies past block 0 (its own rows)
  *   VOFFSET         the offset's code (OFFSET_* of pyoa.constructions)
  *   VS_PACKED       1: the stratum permutation is tabled as 4-bit fields
  *                   (s <= 16); 0: each value walks it (VS_ROUNDS rounds)
@@ -56,6 +58,25 @@ static inline __attribute__((always_inline)) uint8 permute_bounded_v8(uint8 i, u
 
 #ifndef VBASELINE  /* the orthogonal arrays' kernels */
 
+/* Kensler's permute of 8 lanes with one seed p != 0 (a later block's order
+ * of the rows, docs/spec.md section 6): the cycle walk as a loop over the
+ * whole vector, which runs once per (pixel, block, 8 samples), not per value. */
+static inline __attribute__((always_inline)) uint8 permute_walk_v8(uint8 i, uint p, uint l, uint w)
+{
+    uint8 P = (uint8)p;
+    uint8 x = permute_round_v8(i, P, w);
+    while (any(x >= l))
+        x = (x < l) ? x : permute_round_v8(x, P, w);
+    x += p % l;
+    return (x >= l) ? x - l : x;
+}
+
+/* Lanes r of t[idx.sr]: a gather of 8 table entries. */
+static inline __attribute__((always_inline)) uint8 gather_v8(__global const uint *t, uint8 idx)
+{
+    return (uint8)(t[idx.s0], t[idx.s1], t[idx.s2], t[idx.s3], t[idx.s4], t[idx.s5], t[idx.s6], t[idx.s7]);
+}
+
 /* Entries a (< 16) of permutations stored as 4-bit fields: 0..7 in lo, 8..15 in hi. */
 uint8 field4_v8(uint8 lo, uint8 hi, uint8 a) { return (((a < 8u) ? lo : hi) >> ((a & 7u) * 4u)) & 15u; }
 
@@ -90,8 +111,9 @@ static inline __attribute__((always_inline)) void permutation_fields_v8(uint l, 
 /* Per (pixel, dimension) pd of the launch, 8 words at pk[8 pd]: [0, 1] the
  * stratum permutation as fields (VS_PACKED) or [0] its seed; [2, 3] the
  * sub-stratum permutation as fields (VSUB == 1) or [2] its seed; [4] the
- * jitter seed. The keys come from the pixel and dimension numbers here
- * (docs/spec.md sections 3 and 6), not from the host. Each work-item does 8
+ * jitter seed; [5] the seed of the block's order of the rows (0 in block 0,
+ * docs/spec.md section 6). The keys come from the pixel and dimension
+ * numbers here (docs/spec.md sections 3 and 6), not from the host. Each work-item does 8
  * consecutive pd as the lanes of 8-lane vectors (3.3x PoCL's own
  * vectorization of one pd per work-item); the host pads `pixels` and `pk`
  * so that the last work-item's extra lanes read and write in bounds. */
@@ -101,11 +123,13 @@ __kernel void vector_tables(__global uint *restrict pk,
                             const uint seed)
 {
     uint g = (uint)get_global_id(0);
-    uint qs[8];
+    uint qs[8], os[8];
     #pragma unroll
     for (uint r = 0u; r < 8u; ++r) {
         uint pd = 8u * g + r, j = dims[pd % VND];
-        qs[r] = block_seed(pixel_seed(seed, pixels[pd / VND]), j / VDMAX) * (j % VDMAX + 1u);
+        uint P = block_seed(pixel_seed(seed, pixels[pd / VND]), j / VDMAX);
+        qs[r] = P * (j % VDMAX + 1u);
+        os[r] = block_order_seed(P, j / VDMAX, VN);
     }
     uint8 q = vload8(0, qs);
     uint8 w0 = q * STRATUM_KEY, w1 = 0u, w2 = q * SUBSTRATUM_KEY, w3 = 0u, w4 = q * JITTER_KEY;
@@ -119,39 +143,65 @@ __kernel void vector_tables(__global uint *restrict pk,
     #pragma unroll
     for (uint r = 0u; r < 8u; ++r) {
         o[8u * r + 0u] = w0[r]; o[8u * r + 1u] = w1[r]; o[8u * r + 2u] = w2[r];
-        o[8u * r + 3u] = w3[r]; o[8u * r + 4u] = w4[r];
+        o[8u * r + 3u] = w3[r]; o[8u * r + 4u] = w4[r]; o[8u * r + 5u] = os[r];
     }
 }
 
 /* Values of sample positions [8 b, 8 b + 8) of pixel pl (axis 0: b, axis 1:
  * pl), every dimension, written at out + out0 + (pl * VNK + 8 b) * VND. cell_a
- * and cell_u are the cells of docs/spec.md section 5 laid out [d][k] with rows
- * of VNKP (pyoa._numpy.oa.cells, padded), isamp the sample indices (padded). */
+ * and cell_u are the cells of docs/spec.md section 5 at the sample indices,
+ * laid out [d][k] with rows of VNKP (pyoa.host_tables.cells, padded), isamp
+ * the sample indices (padded): block 0's rows. A dimension of a later block
+ * (VLATER: the request has one) reads its copy at its own rows
+ * (docs/spec.md section 6): the row permutation is walked once per block
+ * and 8 samples, and its cells are gathered from every row's cells, array_a
+ * and array_u, laid out [d][row] (pyoa.host_tables.array_cells). */
 __kernel void vector_values(__global float *restrict out,
                             const uint out0,
                             __global const uint *restrict pk,
                             __global const uint *restrict cell_a,
                             __global const uint *restrict cell_u,
                             __global const uint *restrict isamp,
+                            __global const uint *restrict array_a,
+                            __global const uint *restrict array_u,
                             const float J)
 {
     uint b = (uint)get_global_id(0), pl = (uint)get_global_id(1);
     uint8 i = vload8(b, isamp);
     float8 V[VND];
+#if VLATER
+    uint last_order = 0u;
+    uint8 later_row = i;
+#endif
     #pragma unroll
     for (uint d = 0u; d < VND; ++d) {  /* VND is a build constant: unrolled */
         __global const uint *w = pk + 8u * (pl * VND + d);
         uint8 aij = vload8(b, cell_a + d * VNKP);
+        uint8 row = i;
+#if VLATER
+        uint order = w[5];
+        if (order != 0u) {  /* a later block: its own rows (dimensions of one block share them) */
+            if (order != last_order) {
+                later_row = permute_walk_v8(permute_walk_v8(i, order, VN, VWN), mix32(order), VN, VWN);  /* block_row */
+                last_order = order;
+            }
+            row = later_row;
+            aij = gather_v8(array_a + d * VN, row);
+        }
+#endif
 #if VS_PACKED
         uint8 stratum = field4_v8((uint8)w[0], (uint8)w[1], aij);
 #else
         uint8 stratum = permute_bounded_v8(aij, (uint8)w[0], VS, VWS, VS_ROUNDS);
 #endif
-        float8 jit = jitter_value_v8(randfloat_v8(i, w[4]), J);
+        float8 jit = jitter_value_v8(randfloat_v8(row, w[4]), J);
 #if VSUB == 0
         V[d] = centered_value_v8(stratum, jit, VM, VS);
 #else
         uint8 u = vload8(b, cell_u + d * VNKP);
+#if VLATER
+        if (order != 0u) u = gather_v8(array_u + d * VN, row);
+#endif
 #if VSUB == 1
         uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
 #else
@@ -159,7 +209,7 @@ __kernel void vector_values(__global float *restrict out,
 #if VJKEY_BOSE
         uint8 seed = (u * VS + aij + 1u) * w[2];
 #else
-        uint8 seed = (i + 1u) * w[2];
+        uint8 seed = (row + 1u) * w[2];
 #endif
 #elif VOFFSET == OFFSET_MJ
         uint8 seed = (aij + 1u) * w[2];

@@ -201,10 +201,13 @@ class Construction:
     Subclasses define :meth:`choices` (every valid sample count),
     :meth:`solve` and :meth:`invalid` (the parameters for a requested count,
     or why there are none) and their implementations: ``reference`` and
-    ``numpy`` (functions, as ``staticmethod``), ``kernel`` (an OpenCL C
-    expression; for the orthogonal arrays over ``i, j, s, t, p, offset, J,
-    gf, gf_tabled, consts``, for the comparison samplers over ``i, j, p,
-    pixel, seed, a, b, c, J, table`` with ``a, b, c`` the shape arguments).
+    ``numpy`` (functions, as ``staticmethod``) and ``kernel``: OpenCL C. For
+    the orthogonal arrays it is the construction's cell alone, statements
+    over ``row, col, s, t, M, gf, gf_tabled, consts`` that set ``aij``,
+    ``u`` and the 'j' offset's cell key ``ck`` (the block rule and the
+    common tail are shared, ``kernels/oa.cl``); for the comparison samplers
+    an expression over ``i, j, p, pixel, seed, a, b, c, J, table`` with
+    ``a, b, c`` the shape arguments.
     """
 
     name: str

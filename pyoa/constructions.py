@@ -105,7 +105,7 @@ class Bose(_OA):
     partner_cell_key = True
     reference = staticmethod(_reference_oa.bose)
     numpy = staticmethod(_numpy_oa.bose)
-    kernel = "bose(i, j, s, p, offset, J, gf, gf_tabled)"
+    kernel = "bose_cell(row, col, s, gf, gf_tabled, &aij, &u); ck = u * s + aij + 1u"
     description = "Bose OA, strength 2: N = s^2 with s a prime power, s+1 dimensions per block"
     #: the largest prime with s**2 <= MAX_SPP
     max_s = max(p for p in range(math.isqrt(MAX_SPP), 1, -1) if is_prime(p))
@@ -150,7 +150,7 @@ class Bush(_OA):
     uses_field = True
     reference = staticmethod(_reference_oa.bush)
     numpy = staticmethod(_numpy_oa.bush)
-    kernel = "bush(i, j, s, t, p, offset, J, gf, gf_tabled)"
+    kernel = "bush_cell(row, col, s, t, M, gf, gf_tabled, &aij, &u); ck = row + 1u"
     #: t <= s and s**t <= 2**24 allow t <= 8 (8**8 = 2**24; 9**9 is too large)
     max_strength = 8
     description = "Bush OA, strength t: N = s^t with s a prime power and t <= s, s+1 dimensions per block"
@@ -209,7 +209,7 @@ class CMJND(_OA):
     code = 1
     reference = staticmethod(_reference_oa.cmjnd)
     numpy = staticmethod(_numpy_oa.cmjnd)
-    kernel = "cmjnd(i, j, s, t, p, offset, J)"
+    kernel = "cmjnd_cell(row, s, pow_u(s, col), &aij, &u); ck = row + 1u"
     description = "N-dimensional correlated multi-jittered OA: N = s^t for any s >= 2, t dimensions per block"
     max_strength = 24  # 2**24 = MAX_SPP
 
@@ -304,7 +304,7 @@ class AddelmanKempthorne(_Index2):
     reference = staticmethod(_reference_oa.addelman_kempthorne)
     numpy = staticmethod(_numpy_oa.addelman_kempthorne)
     cell = staticmethod(_numpy_oa.addelman_kempthorne_cell)
-    kernel = "addelman_kempthorne(i, j, s, p, offset, J, gf, gf_tabled, consts)"
+    kernel = "addelman_kempthorne_cell(row, col, s, gf, gf_tabled, consts, &aij, &u); ck = row + 1u"
     description = ("Addelman-Kempthorne OA, strength 2, index 2: N = 2q^2 with q an odd prime power, "
                    "2q+1 dimensions per block")
 
@@ -338,7 +338,7 @@ class BoseBush(_Index2):
     reference = staticmethod(_reference_oa.bose_bush)
     numpy = staticmethod(_numpy_oa.bose_bush)
     cell = staticmethod(_numpy_oa.bose_bush_cell)
-    kernel = "bose_bush(i, j, s, p, offset, J, gf, gf_tabled)"
+    kernel = "bose_bush_cell(row, col, s, gf, gf_tabled, &aij, &u); ck = row + 1u"
     description = "Bose-Bush OA, strength 2, index 2: N = 2s^2 with s a power of two, 2s+1 dimensions per block"
 
     @staticmethod

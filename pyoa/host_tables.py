@@ -13,16 +13,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._numpy.oa import block_order_seed
 from .hashes import U32, block_seed, pixel_seed
 from .reference.hashes import STRATUM_KEY, SUBSTRATUM_KEY
 
 
 def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     """``(A_ij, u)`` of sample positions ``[k0, k1)`` of request ``req`` in each
-    of its dimensions: two C-contiguous uint32 arrays of shape
+    of its dimensions, read at row ``i`` (the rows of block 0; later blocks
+    read their own rows, docs/spec.md section 6, and their cells come from
+    :func:`array_cells`): two C-contiguous uint32 arrays of shape
     ``(n_dims, k1 - k0)``.
 
-    A cell depends on the sample and the column only, not on the pixel, so the
+    A block-0 cell depends on the sample and the column only, not on the pixel, so the
     table path computes it once per rectangle of pixels x samples and gathers
     the pixel's permutations with it (both backends; the OpenCL kernel
     ``generate_cells`` reads exactly these arrays, and the vector path of
@@ -41,20 +44,51 @@ def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
 
 
-def column_keys(req, pix0: int, pix1: int) -> np.ndarray:
-    """:func:`column_key` of every (pixel, dimension) of pixels ``[pix0, pix1)``
-    of request ``req``, shape ``(pixels, n_dims)``.
+def array_cells(req) -> tuple[np.ndarray, np.ndarray]:
+    """``(A_ij, u)`` of every row ``0..N-1`` of the array in each requested
+    dimension's column: two C-contiguous uint32 arrays of shape
+    ``(n_dims, N)``, laid out ``[d][row]``. The table paths gather from them
+    at a later block's own rows (docs/spec.md section 6). ``u`` is 0 for the
+    ``centered`` offset."""
+    prm = req.params
+    rows = np.arange(prm.s * prm.M, dtype=U32)[None, :]
+    col = (req.dims % U32(prm.block_dims))[:, None]
+    aij, u = req.construction.cells(rows, col, prm)
+    shape = (req.n_dims, prm.s * prm.M)
+    aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
+    if req.offset == "centered":
+        return aij, np.zeros(shape, U32)
+    return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
 
-    The block seed is hashed once per pixel and distinct block, not per
-    (pixel, dimension): requests have few blocks and many dimensions per
-    block."""
-    dmax = req.params.block_dims
+
+def block_seeds(req, pix0: int, pix1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The block rule's per-pixel part (docs/spec.md section 6) for pixels
+    ``[pix0, pix1)`` of request ``req``: ``(blocks, which, seeds, orders)``.
+
+    ``blocks`` are the distinct blocks the request's dimensions fall in
+    (sorted), ``which[d]`` the index into ``blocks`` of dimension ``d``;
+    ``seeds`` and ``orders``, shape ``(pixels, len(blocks))``, are each
+    block's array seed ``block_seed(p, b)`` and the seed of its sample order
+    ``block_order_seed(P, b, N)`` (0 for block 0). They are hashed once per
+    pixel and distinct block, not per (pixel, dimension): requests have few
+    blocks and many dimensions per block."""
+    prm = req.params
     p = pixel_seed(req.seed, req.pixels[pix0:pix1])
-    if len(p) == 0 or req.n_dims == 0:
-        return np.empty((len(p), req.n_dims), dtype=U32)
-    blocks, which = np.unique(req.dims // U32(dmax), return_inverse=True)
-    seeds = np.stack([block_seed(p, b) for b in blocks], axis=1)  # (pixels, distinct blocks)
-    return seeds[:, which] * (req.dims % U32(dmax) + U32(1))
+    blocks, which = np.unique(req.dims // U32(prm.block_dims), return_inverse=True)
+    seeds = np.stack([block_seed(p, b) for b in blocks], axis=1).reshape(len(p), len(blocks))
+    orders = block_order_seed(seeds, blocks[None, :], prm.s * prm.M)
+    return blocks, which.ravel(), seeds, orders
+
+
+def column_keys(req, pix0: int, pix1: int) -> np.ndarray:
+    """The column key ``q = P * (col + 1)`` of every (pixel, dimension) of
+    pixels ``[pix0, pix1)`` of request ``req``, shape ``(pixels, n_dims)``:
+    times STRATUM_KEY, SUBSTRATUM_KEY and JITTER_KEY it gives the column's
+    three seeds (docs/spec.md section 3.3; ``P`` from :func:`block_seeds`)."""
+    if pix1 == pix0 or req.n_dims == 0:
+        return np.empty((pix1 - pix0, req.n_dims), dtype=U32)
+    _, which, seeds, _ = block_seeds(req, pix0, pix1)
+    return seeds[:, which] * (req.dims % U32(req.params.block_dims) + U32(1))
 
 
 def table_keys(req, pix0: int, pix1: int) -> np.ndarray:

@@ -16,6 +16,10 @@ import numpy as np
 
 from .catalogue_types import Construction, Params
 
+#: Most cells (entries per array, each of 4 bytes, twice) the OpenCL table
+#: path uploads for dimensions past the first block (:attr:`Request.array_cells_fit`).
+MAX_ARRAY_CELLS = 1 << 22
+
 
 @dataclass(frozen=True)
 class Request:
@@ -66,6 +70,21 @@ class Request:
                 rects.append(Rect(r, r1, pix, r1 // n_s, 0, n_s))
             r = r1
         return rects
+
+    @property
+    def past_block0(self) -> bool:
+        """Whether a dimension lies past the first block (docs/spec.md section
+        6): such a dimension reads its copy at its own rows, which depend on
+        the pixel, so the table paths gather its cells at those rows."""
+        return self.n_dims > 0 and int(self.dims.max()) >= self.params.block_dims
+
+    @property
+    def array_cells_fit(self) -> bool:
+        """Whether the OpenCL table path may hold the cells of every row of
+        the array in each dimension's column (:func:`pyoa.host_tables.array_cells`),
+        which it needs for dimensions past the first block: at most
+        :data:`MAX_ARRAY_CELLS` entries. Larger requests take the direct path."""
+        return not self.past_block0 or self.n_dims * self.params.s * self.params.M <= MAX_ARRAY_CELLS
 
     @property
     def table_stride(self) -> int:

@@ -13,17 +13,17 @@ import drjit as dr
 from .. import catalogue
 from . import baselines, faure, hashes, oa
 
-#: Entry name -> its Dr.Jit implementation. Every orthogonal array, faure and
-#: random; the other comparison samplers read tables (Sobol' matrices, PMJ02
-#: points) and are left to Mitsuba's own samplers.
+#: Family -> the module of its Dr.Jit implementations: an entry is supported
+#: when that module defines a function named as the entry (``entry.function``).
+#: Every orthogonal array, faure and random; the other comparison samplers read
+#: tables (Sobol' matrices, PMJ02 points) and are left to Mitsuba's own samplers.
+MODULES = {"oa": oa, "progressive": faure, "baseline": baselines}
+
+#: Entry name -> its Dr.Jit implementation, from the catalogue.
 IMPLEMENTATIONS = {
-    "bose": oa.bose,
-    "bush": oa.bush,
-    "cmjnd": oa.cmjnd,
-    "addelman-kempthorne": oa.addelman_kempthorne,
-    "bose-bush": oa.bose_bush,
-    "faure": faure.faure,
-    "random": baselines.random,
+    entry.name: f
+    for entry in map(catalogue.get, catalogue.names())
+    if callable(f := getattr(MODULES.get(entry.family), entry.function, None))
 }
 
 #: The supported names, in the catalogue's order.

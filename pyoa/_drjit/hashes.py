@@ -11,7 +11,7 @@ from __future__ import annotations
 import drjit as dr
 
 from ..reference.floats import UNIT_SCALE
-from ..reference.hashes import BLOCK_KEY, PIXEL_KEY, walk_mask
+from ..reference.hashes import BLOCK_KEY, BLOCK_ORDER_KEY, PIXEL_KEY, walk_mask
 
 
 def mix32(x):
@@ -42,6 +42,39 @@ def block_seed(p, block):
     U = type(p) if dr.is_array_v(p) else type(block)
     p, block = U(p), U(block)
     return dr.select(block == 0, p, hash_pair(p, block, BLOCK_KEY))
+
+
+def block_order_seed(P, block, N: int):
+    """The seed of block ``block``'s sample order (:func:`pyoa.reference.hashes.block_order_seed`):
+    0 for block 0 (``permute`` with seed 0 is the identity), else
+    ``hash_pair(P, N, BLOCK_ORDER_KEY)``."""
+    U = type(P) if dr.is_array_v(P) else type(block)
+    P, block = U(P), U(block)
+    return dr.select(block == 0, U(0), hash_pair(P, N, BLOCK_ORDER_KEY))
+
+
+def locate(p, i, j, B: int, N: int):
+    """The block rule (docs/spec.md section 6, :func:`pyoa.reference.hashes.locate`):
+    ``(P, row, col)`` of dimension ``j`` of sample ``i`` in an array of ``N``
+    rows and ``B`` columns with seed ``p``. Block ``j // B`` has seed
+    ``P = block_seed(p, block)`` and reads row :func:`block_row` of ``i``
+    (row ``i`` for block 0).
+
+    ``B`` and ``N`` are Python ints fixed at trace time, like the cells' ``s``
+    and :func:`permute`'s ``l``: Dr.Jit compiles an integer division by a
+    literal to an exact multiply-and-shift (the float32 one is not exact,
+    :mod:`.floats`; the tests compare against NumPy bit for bit)."""
+    U = next((type(x) for x in (i, j, p) if dr.is_array_v(x)), None)
+    i, j = U(i), U(j)
+    block, col = j // B, j % B
+    P = block_seed(p, block)
+    return P, block_row(i, N, block_order_seed(P, block, N)), col
+
+
+def block_row(i, N: int, r):
+    """``permute(permute(i, N, r), N, mix32(r))`` (:func:`pyoa.reference.hashes.block_row`):
+    the row of sample ``i`` in a block whose order seed is ``r``; ``i`` where ``r == 0``."""
+    return permute(permute(i, N, r), N, mix32(r))
 
 
 def derived_seed(p, index, key: int):

@@ -6,6 +6,11 @@ Each sampler takes ``UInt32`` arrays of sample indices ``i``, dimensions ``j``
 (any ``j >= 0``; blocks per section 6) and point-set seeds ``p``; its shape
 (``s``, ``t``), offset style and jitter amount are Python values fixed when the
 code is traced. Values are ``Float32`` arrays of the same backend.
+
+As in the reference, a construction supplies only its cell (``*_cell``: the
+integer cell of row ``row`` in column ``col``); one shared frame,
+:func:`oa_value`, applies the block rule (:func:`.hashes.locate`) and turns
+the cell into x.
 """
 
 from __future__ import annotations
@@ -18,12 +23,7 @@ import numpy as np
 from .. import gf
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import centered_value, jitter_value, sample_value
-from .hashes import block_seed, permute, randfloat
-
-
-def column_key(p, j, dmax: int):
-    """``block_seed(p, j // dmax) * (j % dmax + 1)``: the dimension seeds' common factor."""
-    return block_seed(p, j // dmax) * (j % dmax + 1)
+from .hashes import locate, permute, randfloat
 
 
 @cache
@@ -103,37 +103,45 @@ def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
     return permute(u, M, seed)
 
 
-def oa_value(i, stratum, u, M: int, s: int, offset: str, jitter: float, q, cell_key, aij):
-    """x from the stratum, the sub-stratum index ``u`` and the column key ``q``."""
-    jit = jitter_value(randfloat(i, q * JITTER_KEY), jitter)
+def oa_value(i, j, p, offset: str, jitter: float, *, N: int, B: int, s: int, M: int, cell):
+    """:func:`pyoa.reference.oa.oa_value` over Dr.Jit arrays: the frame every
+    construction shares. The block rule (:func:`.hashes.locate`) gives the
+    copy's seed, the row and the column; ``cell(row, col)`` gives
+    ``(A_ij, u, cell_key)``; then stratum, offset and the jitter of the row
+    (docs/spec.md section 5.2)."""
+    P, row, col = locate(p, i, j, B, N)
+    aij, u, cell_key = cell(row, col)
+    q = P * (col + 1)  # times the three keys: the column's seeds (section 3.3)
+    stratum = permute(aij, s, q * STRATUM_KEY)
+    jit = jitter_value(randfloat(row, q * JITTER_KEY), jitter)
     if offset == "centered":
         return centered_value(stratum, jit, M, s)
     sub = offset_sub(offset, u, M, cell_key, aij, q * SUBSTRATUM_KEY)
     return sample_value(stratum, sub, jit, M, s)
 
 
+def _row_key(cell, *shape):
+    """A construction's cell with the 'j' offset's key ``row + 1``."""
+    return lambda row, col: (*cell(row, col, *shape), row + 1)
+
+
 def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.bose` over Dr.Jit arrays."""
-    q = column_key(p, j, s + 1)
-    aij, aik = bose_cell(i, j % (s + 1), s)
-    stratum = permute(aij, s, q * STRATUM_KEY)
-    return oa_value(i, stratum, aik, s, s, offset, jitter, q, aik * s + aij + 1, aij)
+    def cell(row, col):
+        aij, aik = bose_cell(row, col, s)
+        return aij, aik, aik * s + aij + 1  # the 'j' offset's key is the (A_ij, A_ik) cell
+
+    return oa_value(i, j, p, offset, jitter, N=s * s, B=s + 1, s=s, M=s, cell=cell)
 
 
 def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.cmjnd` over Dr.Jit arrays."""
-    q = column_key(p, j, t)
-    aij, v = cmjnd_cell(i, j % t, s, t)
-    stratum = permute(aij, s, q * STRATUM_KEY)
-    return oa_value(i, stratum, v, s ** (t - 1), s, offset, jitter, q, i + 1, aij)
+    return oa_value(i, j, p, offset, jitter, N=s**t, B=t, s=s, M=s ** (t - 1), cell=_row_key(cmjnd_cell, s, t))
 
 
 def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.bush` over Dr.Jit arrays."""
-    q = column_key(p, j, s + 1)
-    aij, u = bush_cell(i, j % (s + 1), s, t)
-    stratum = permute(aij, s, q * STRATUM_KEY)
-    return oa_value(i, stratum, u, s ** (t - 1), s, offset, jitter, q, i + 1, aij)
+    return oa_value(i, j, p, offset, jitter, N=s**t, B=s + 1, s=s, M=s ** (t - 1), cell=_row_key(bush_cell, s, t))
 
 
 def addelman_kempthorne_cell(i, col, q: int):
@@ -168,18 +176,13 @@ def bose_bush_cell(i, col, s: int):
     return dr.select(last, x % s, a), dr.select(last, (x // s) * s + k, x)
 
 
-def _index2(cell, i, j, s: int, p, offset: str, jitter: float):
-    q = column_key(p, j, 2 * s + 1)
-    aij, u = cell(i, j % (2 * s + 1), s)
-    stratum = permute(aij, s, q * STRATUM_KEY)
-    return oa_value(i, stratum, u, 2 * s, s, offset, jitter, q, i + 1, aij)
-
-
 def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.addelman_kempthorne` over Dr.Jit arrays."""
-    return _index2(addelman_kempthorne_cell, i, j, q, p, offset, jitter)
+    return oa_value(i, j, p, offset, jitter, N=2 * q * q, B=2 * q + 1, s=q, M=2 * q,
+                    cell=_row_key(addelman_kempthorne_cell, q))
 
 
 def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.bose_bush` over Dr.Jit arrays."""
-    return _index2(bose_bush_cell, i, j, s, p, offset, jitter)
+    return oa_value(i, j, p, offset, jitter, N=2 * s * s, B=2 * s + 1, s=s, M=2 * s,
+                    cell=_row_key(bose_bush_cell, s))

@@ -14,8 +14,8 @@ from .. import host_tables
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from ..request import Rect, Request
 from . import oa
-from .floats import F32
-from .hashes import U32, permute
+from .floats import F32, jitter_value, sample_value
+from .hashes import U32, permute, randfloat
 
 #: Values per chunk: bounds the temporaries (about 20 arrays of this size).
 CHUNK_VALUES = 1 << 20
@@ -55,19 +55,34 @@ class NumpyBackend:
     @staticmethod
     def _tabled(req: Request, rect: Rect) -> np.ndarray:
         """Values of ``rect`` as ``(pixels, samples, dims)``: the per-(pixel,
-        dimension) permutations computed once, the pixel-independent cells
-        (:func:`pyoa.host_tables.cells`) once, then one gather per value."""
+        dimension) permutations computed once, the cells once (block 0's do
+        not depend on the pixel, :func:`pyoa.host_tables.cells`; a later
+        block's are read at its own rows, docs/spec.md section 6), then one
+        gather per value."""
         prm = req.params
-        s, M = prm.s, prm.M
-        q = host_tables.column_keys(req, rect.pix0, rect.pix1)  # (pixels, dims)
-        aij, u = (c.T for c in host_tables.cells(req, rect.k0, rect.k1))  # (samples, dims)
+        s, M, N = prm.s, prm.M, prm.s * prm.M
+        blocks, which, seeds, orders = host_tables.block_seeds(req, rect.pix0, rect.pix1)
+        col = req.dims % U32(prm.block_dims)
+        q = seeds[:, which] * (col + U32(1))  # (pixels, dims): the column keys
+        i = req.samples[rect.k0 : rect.k1]
+        n_p, n_k = rect.n_pixels, rect.n_k
+        rows = np.broadcast_to(i[None, :, None], (n_p, n_k, req.n_dims)).copy()
+        aij, u = (np.broadcast_to(c.T[None], rows.shape).copy() for c in host_tables.cells(req, rect.k0, rect.k1))
+        for b, block in enumerate(blocks):
+            if block == 0:
+                continue
+            d = np.flatnonzero(which == b)
+            r = oa.block_row(i[None, :], N, orders[:, b, None])[..., None]  # (pixels, samples, 1): the block's rows
+            rows[..., d] = r
+            aij[..., d], u[..., d] = req.construction.cells(r, col[d][None, None, :], prm)
         d = np.arange(req.n_dims)
+        pl = np.arange(n_p)[:, None, None]
         strata = permute(np.arange(s, dtype=U32), s, (q * U32(STRATUM_KEY))[..., None])  # (pixels, dims, s)
-        stratum = strata[:, d, aij]  # (pixels, samples, dims)
+        stratum = strata[pl, d, aij]
         if req.offset == "cmj":
             subs = permute(np.arange(M, dtype=U32), M, (q * U32(SUBSTRATUM_KEY))[..., None])
-            sub = subs[:, d, u]
+            sub = subs[pl, d, u]
         else:
             sub = F32((M - 1) / 2)
-        i = req.samples[rect.k0 : rect.k1][None, :, None]
-        return oa.oa_value(i, stratum, sub, (q * U32(JITTER_KEY))[:, None, :], M, s, req.jitter)
+        return sample_value(stratum, sub, jitter_value(randfloat(rows, (q * U32(JITTER_KEY))[:, None, :]),
+                                                       F32(req.jitter)), M, s)

@@ -4,8 +4,8 @@ and, piece by piece, ``kernels/oa.cl``).
 Each function takes broadcastable arrays of sample indices ``i``, dimensions
 ``j`` (any ``j >= 0``; blocks per docs/spec.md section 6) and array seeds ``p`` and
 returns float32 values; see the reference for the mathematics. The pieces
-(column key, cell, offset, value) are public to this package because the
-NumPy backend's table path (:mod:`.backend`) reuses them.
+(block rule, cell, offset) are public to this package because the NumPy
+backend's table path (:mod:`.backend`) reuses them.
 """
 
 from __future__ import annotations
@@ -15,16 +15,33 @@ from functools import lru_cache
 import numpy as np
 
 from .. import gf
-from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
+from ..reference.hashes import BLOCK_ORDER_KEY, JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import F32, jitter_value, sample_value
-from .hashes import U32, block_seed, permute, randfloat
+from .hashes import U32, block_seed, hash_pair, mix32, permute, randfloat
 
 
-def column_key(p, j, dmax: int) -> np.ndarray:
-    """``block_seed(p, j // dmax) * (j % dmax + 1)``: times STRATUM_KEY,
-    SUBSTRATUM_KEY and JITTER_KEY it gives the dimension seeds."""
-    j = np.asarray(j, dtype=U32)
-    return block_seed(p, j // U32(dmax)) * (j % U32(dmax) + U32(1))
+def locate(p, i, j, B: int, N: int):
+    """The block rule (docs/spec.md section 6, :func:`pyoa.reference.hashes.locate`)
+    over arrays: ``(P, row, col)`` of dimension ``j`` of sample ``i`` in an
+    array of ``N`` rows and ``B`` columns with seed ``p``. Block 0 reads row
+    ``i`` (its order seed is 0, and ``permute`` with seed 0 is the identity);
+    block ``b >= 1`` reads row :func:`block_row` of ``i``."""
+    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
+    block, col = j // U32(B), j % U32(B)
+    P = block_seed(p, block)
+    return P, block_row(i, N, block_order_seed(P, block, N)), col
+
+
+def block_row(i, N: int, r) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.hashes.block_row`: ``permute(permute(i,
+    N, r), N, mix32(r))``, the identity where ``r == 0``."""
+    return permute(permute(i, N, r), N, mix32(r))
+
+
+def block_order_seed(P, block, N: int) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.hashes.block_order_seed` (0 for block 0)."""
+    P, block = np.broadcast_arrays(np.asarray(P, dtype=U32), np.asarray(block, dtype=U32))
+    return np.where(block == 0, U32(0), hash_pair(P, N, BLOCK_ORDER_KEY))
 
 
 @lru_cache(maxsize=None)
@@ -103,41 +120,41 @@ def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
     return permute(u, M, seed)
 
 
-def oa_value(i, stratum, sub, P3, M: int, s: int, jitter: float) -> np.ndarray:
-    """``(stratum + (sub + jitter) / M) / s`` with the jitter of sample ``i``."""
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), F32(jitter)), M, s)
+def oa_value(i, j, p, offset: str, jitter: float, *, N: int, B: int, s: int, M: int, cell) -> np.ndarray:
+    """Vectorized :func:`pyoa.reference.oa.oa_value`: the frame every
+    construction shares. The block rule (:func:`locate`) gives the copy's seed,
+    the row and the column; ``cell(row, col)`` gives ``(A_ij, u, cell_key)``;
+    then stratum, offset and jitter (docs/spec.md section 5.2)."""
+    P, row, col = locate(p, i, j, B, N)
+    aij, u, cell_key = cell(row, col)
+    q = P * (col + U32(1))  # times the three keys: the column's seeds (section 3.3)
+    stratum = permute(aij, s, q * U32(STRATUM_KEY))
+    sub = offset_sub(offset, u, M, cell_key, aij, q * U32(SUBSTRATUM_KEY))
+    return sample_value(stratum, sub, jitter_value(randfloat(row, q * U32(JITTER_KEY)), F32(jitter)), M, s)
 
 
 def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bose` (parameters assumed valid)."""
-    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
-    q = column_key(p, j, s + 1)
-    aij, aik = bose_cell(i, j % U32(s + 1), s)
-    stratum = permute(aij, s, q * U32(STRATUM_KEY))
-    sub = offset_sub(offset, aik, s, aik * U32(s) + aij + U32(1), aij, q * U32(SUBSTRATUM_KEY))
-    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), s, s, jitter)
+    def cell(row, col):
+        aij, aik = bose_cell(row, col, s)
+        return aij, aik, aik * U32(s) + aij + U32(1)
+
+    return oa_value(i, j, p, offset, jitter, N=s * s, B=s + 1, s=s, M=s, cell=cell)
+
+
+def _row_key(cell, *shape):
+    """A construction's cell with the 'j' offset's key ``row + 1``."""
+    return lambda row, col: (*cell(row, col, *shape), row + U32(1))
 
 
 def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.cmjnd` (parameters assumed valid)."""
-    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
-    q = column_key(p, j, t)
-    M = s ** (t - 1)
-    aij, v = cmjnd_cell(i, j % U32(t), s)
-    stratum = permute(aij, s, q * U32(STRATUM_KEY))
-    sub = offset_sub(offset, v, M, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
-    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)
+    return oa_value(i, j, p, offset, jitter, N=s**t, B=t, s=s, M=s ** (t - 1), cell=_row_key(cmjnd_cell, s))
 
 
 def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bush` (parameters assumed valid)."""
-    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
-    q = column_key(p, j, s + 1)
-    M = s ** (t - 1)
-    aij, u = bush_cell(i, j % U32(s + 1), s, t)
-    stratum = permute(aij, s, q * U32(STRATUM_KEY))
-    sub = offset_sub(offset, u, M, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
-    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), M, s, jitter)
+    return oa_value(i, j, p, offset, jitter, N=s**t, B=s + 1, s=s, M=s ** (t - 1), cell=_row_key(bush_cell, s, t))
 
 
 @lru_cache(maxsize=None)
@@ -182,20 +199,13 @@ def bose_bush_cell(i, col, s: int):
     return np.where(last, x % S, a), np.where(last, (x // S) * S + k, x)
 
 
-def _index2(cell, i, j, s: int, p, offset: str, jitter: float) -> np.ndarray:
-    i, j = np.asarray(i, dtype=U32), np.asarray(j, dtype=U32)
-    q = column_key(p, j, 2 * s + 1)
-    aij, u = cell(i, j % U32(2 * s + 1), s)
-    stratum = permute(aij, s, q * U32(STRATUM_KEY))
-    sub = offset_sub(offset, u, 2 * s, i + U32(1), aij, q * U32(SUBSTRATUM_KEY))
-    return oa_value(i, stratum, sub, q * U32(JITTER_KEY), 2 * s, s, jitter)
-
-
 def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.addelman_kempthorne` (parameters assumed valid)."""
-    return _index2(addelman_kempthorne_cell, i, j, q, p, offset, jitter)
+    return oa_value(i, j, p, offset, jitter, N=2 * q * q, B=2 * q + 1, s=q, M=2 * q,
+                    cell=_row_key(addelman_kempthorne_cell, q))
 
 
 def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bose_bush` (parameters assumed valid)."""
-    return _index2(bose_bush_cell, i, j, s, p, offset, jitter)
+    return oa_value(i, j, p, offset, jitter, N=2 * s * s, B=2 * s + 1, s=s, M=2 * s,
+                    cell=_row_key(bose_bush_cell, s))

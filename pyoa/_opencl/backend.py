@@ -194,6 +194,7 @@ class OpenCLBackend:
                 kernel = "generate"
                 extra = (np.uint32(req.seed), np.uint32(req.construction.code),
                          np.uint32(prm.s), np.uint32(prm.strength),
+                         np.uint32(prm.block_dims), np.uint32(prm.s * prm.M), np.uint32(prm.M),
                          np.uint32(catalogue_types.OFFSET_CODES[req.offset]), np.float32(req.jitter),
                          *self._field(req.construction.field_order(prm)), self._constants(req))
             use_vector = self.path == "vector" and (
@@ -213,7 +214,7 @@ class OpenCLBackend:
                     if shp is not None:
                         self._launch_vector(req, rect, shp, buf, at, dims)
                         continue
-                    if self.path != "direct" and req.tables_pay_off(rect):
+                    if self.path != "direct" and req.tables_pay_off(rect) and req.array_cells_fit:
                         self._launch_tabled(req, rect, buf, at)
                         continue
                 # only the rectangle's pixels and samples travel to the device
@@ -257,8 +258,10 @@ class OpenCLBackend:
         pixels = cl.Buffer(self.context, ro, hostbuf=pixels)
         self._launch_1d(k_tables, groups, pk, pixels, dims, np.uint32(req.seed))
         aij, u, samples = (cl.Buffer(self.context, ro, hostbuf=a) for a in vector.cell_arrays(req, shp))
+        # every row's cells for the later blocks (a placeholder where the request has none)
+        array_a, array_u = self._array_cells(req) if shp.later else (samples, samples)
         self._launch_2d_kernel(k_values, shp.n_blocks, rect.n_pixels,
-                               buf, np.uint32(at), pk, aij, u, samples, np.float32(req.jitter))
+                               buf, np.uint32(at), pk, aij, u, samples, array_a, array_u, np.float32(req.jitter))
 
     def _launch_vector_baseline(self, req: Request, rect: Rect, shp: vector.BaselineShape, buf, at: int,
                                 dims) -> None:
@@ -274,12 +277,13 @@ class OpenCLBackend:
                                np.uint32(req.seed), np.float32(req.jitter))
 
     def _launch_tabled(self, req: Request, rect: Rect, buf, at: int) -> None:
-        """The table path over one rectangle: ``tables`` then ``generate_cells``,
-        writing values ``[at, at + rect values)`` of ``buf``. Called with
-        self._lock held."""
+        """The table path over one rectangle: ``tables`` then ``generate_cells``
+        (every dimension in block 0) or ``block_rows`` and ``generate_rows``
+        (later blocks read their own rows, docs/spec.md section 6), writing
+        values ``[at, at + rect values)`` of ``buf``. Called with self._lock held."""
         import pyopencl as cl
 
-        from ..host_tables import cells, table_keys
+        from ..host_tables import block_seeds, cells, table_keys
 
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         prm = req.params
@@ -289,15 +293,55 @@ class OpenCLBackend:
         tab = self._scratch("tables", n_pd * Es * 4)
         for name in ("tables", "tables_finish"):
             self._launch_2d(name, Es, n_pd, tab, keys, np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M))
-        aij, u = cells(req, rect.k0, rect.k1)
+        samples = np.ascontiguousarray(req.samples[rect.k0 : rect.k1])
+        centered = req.offset == "centered"
+        if not req.past_block0:
+            aij, u = cells(req, rect.k0, rect.k1)
+            self._launch_2d(
+                "generate_cells_centered" if centered else "generate_cells", n_k, n_pd,
+                buf, np.uint32(at), tab,
+                cl.Buffer(self.context, ro, hostbuf=aij), cl.Buffer(self.context, ro, hostbuf=u),
+                cl.Buffer(self.context, ro, hostbuf=samples),
+                np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M),
+                np.float32(req.jitter),
+            )
+            return
+        # later blocks: one slot of rows per (pixel, block >= 1) after block 0's (the samples)
+        blocks, which, _, orders = block_seeds(req, rect.pix0, rect.pix1)
+        later = blocks != 0
+        n_later = int(later.sum())
+        slot = np.zeros(len(blocks), np.int64)
+        slot[later] = 1 + np.arange(n_later)
+        offsets = (slot[which][None, :] + np.where(later[which], n_later, 0)[None, :]
+                   * np.arange(rect.n_pixels)[:, None]) * n_k  # (pixels, dims)
+        rows = self._scratch("rows", (1 + rect.n_pixels * n_later) * n_k * 4)
+        cl.enqueue_copy(self.queue, rows, samples)
+        order_seeds = np.ascontiguousarray(orders[:, later], dtype=np.uint32)
+        self._launch_2d("block_rows", n_k, rect.n_pixels * n_later, rows,
+                        cl.Buffer(self.context, ro, hostbuf=order_seeds), np.uint32(n_k), np.uint32(prm.s * prm.M))
+        aij, u = self._array_cells(req)
         self._launch_2d(
-            "generate_cells_centered" if req.offset == "centered" else "generate_cells", n_k, n_pd,
-            buf, np.uint32(at), tab,
-            cl.Buffer(self.context, ro, hostbuf=aij), cl.Buffer(self.context, ro, hostbuf=u),
-            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1])),
+            "generate_rows_centered" if centered else "generate_rows", n_k, n_pd,
+            buf, np.uint32(at), tab, aij, u, rows,
+            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(offsets, dtype=np.uint32)),
             np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M),
-            np.float32(req.jitter),
+            np.uint32(prm.s * prm.M), np.float32(req.jitter),
         )
+
+    def _array_cells(self, req: Request) -> tuple:
+        """Device buffers of :func:`pyoa.host_tables.array_cells` of ``req``,
+        uploaded once per request shape (the last one is kept: a render asks
+        for the same shape batch after batch). Called with self._lock held."""
+        import pyopencl as cl
+
+        from ..host_tables import array_cells
+
+        key = (req.construction.name, req.params, req.offset, req.dims.tobytes())
+        if getattr(self, "_cells_key", None) != key:
+            ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
+            self._cells_bufs = tuple(cl.Buffer(self.context, ro, hostbuf=a) for a in array_cells(req))
+            self._cells_key = key
+        return self._cells_bufs
 
 
 def _field_tables(q: int) -> tuple[np.ndarray, bool]:

@@ -72,21 +72,25 @@ def dispatch_source() -> str:
     """The kernels' dispatch, generated from the catalogue's entries.
 
     ``oa_dispatch`` (called by ``generate`` in kernels/generate.cl, which
-    declares it) has one ``case`` per orthogonal-array entry, evaluating its
-    ``kernel`` expression; its ``default`` (an unregistered code, which the
+    declares it) applies the block rule (``oa_locate``), then has one
+    ``case`` per orthogonal-array entry, running its ``kernel`` statements
+    (the construction's cell), then the common tail (``oa_tail``); its ``default`` (an unregistered code, which the
     host never launches) gives NaN, never another construction's value. Each
     comparison sampler gets its own kernel ``generate_<name>``
     (``GENERATE_BASELINE``). Registering an entry is all it takes."""
     entries = list(catalogue.SAMPLERS.values())
     lines = [
         "/* ---- generated from the catalogue (pyoa._opencl.program.dispatch_source) ---- */",
-        "float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint p, uint offset, float J,",
-        "               __global const ushort *gf, uint gf_tabled, __global const uint *consts)",
+        "float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint B, uint N, uint M, uint p,",
+        "                  uint offset, float J, __global const ushort *gf, uint gf_tabled, __global const uint *consts)",
         "{",
+        "    uint P, row, col, aij = 0u, u = 0u, ck = 0u;",
+        "    oa_locate(p, i, j, B, N, &P, &row, &col);  /* the block rule, docs/spec.md section 6 */",
         "    switch (construction) {",
     ]
-    lines += [f"    case CONSTRUCTION_{c.function.upper()}: return {c.kernel};" for c in entries if c.family == "oa"]
-    lines += ["    default: return NAN;  /* not a registered construction */", "    }", "}"]
+    lines += [f"    case CONSTRUCTION_{c.function.upper()}: {c.kernel}; break;" for c in entries if c.family == "oa"]
+    lines += ["    default: return NAN;  /* not a registered construction */", "    }",
+              "    return oa_tail(row, col, P, aij, u, ck, s, M, offset, J);", "}"]
     lines += [f"GENERATE_BASELINE({c.function}, {c.kernel})" for c in entries if c.family != "oa"]
     return "\n".join(lines) + "\n"
 

@@ -92,6 +92,7 @@ class Shape(_Rows):
     s_packed: bool
     sub: int  # 0 none, 1 tabled as fields, 2 walked per value
     jkey_bose: bool
+    later: bool = False  # some dimension lies past block 0 (docs/spec.md section 6)
 
     @property
     def tabled(self) -> bool:
@@ -111,6 +112,7 @@ class Shape(_Rows):
             "VDMAX": f"{self.block_dims}u", "VOFFSET": catalogue_types.OFFSET_CODES[self.offset],
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
+            "VN": f"{self.s * self.M}u", "VWN": f"{walk_mask(self.s * self.M)}u", "VLATER": int(self.later),
         })
 
 
@@ -157,7 +159,7 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     prm = req.params
     if req.construction.family != "oa" or rect.n_k != len(req.samples) or rect.n_k < LANES:
         return None
-    if not 1 <= req.n_dims <= MAX_DIMS:
+    if not 1 <= req.n_dims <= MAX_DIMS or not req.array_cells_fit:
         return None
     s_packed = prm.s <= 16
     if not s_packed and walk_rounds(prm.s) > MAX_ROUNDS:
@@ -171,7 +173,7 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     else:
         return None
     return Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
-                 req.construction.partner_cell_key)
+                 req.construction.partner_cell_key, req.past_block0)
 
 
 def store_code(n_dims: int, tail: int) -> tuple[str, str]:

@@ -8,13 +8,15 @@ array with seed ``p``, as a Python float holding a float32 value in
 
 with ``stratum = permute(A_ij, s, P1_j)``, ``sub`` chosen by the offset style
 (docs/spec.md section 4) and ``jitter = 0.5 + J * (randfloat(i, P3_j) - 0.5)``.
-Dimensions past a block of ``block_dims`` columns come from independently
-randomized copies of the array (docs/spec.md section 6, :func:`~.hashes.block_seed`).
+Dimensions past a block of ``B`` columns come from independently
+randomized copies of the array, each read in its own sample order
+(docs/spec.md section 6, :func:`~.hashes.locate`).
 
 Each sampler is split like ``pyoa._numpy.oa`` and ``kernels/oa.cl``: a
-``*_cell`` function gives the integer cell of sample ``i`` in column ``col``
+``*_cell`` function gives the integer cell of row ``row`` in column ``col``
 (``A_ij`` and the sub-stratum index ``u``; for Bose the partner entry
-``A_ik``), and one shared tail, :func:`_value`, turns a cell into ``x``.
+``A_ik``), and one shared frame, :func:`oa_value`, applies the block rule
+and turns a cell into ``x``.
 
 References
 ----------
@@ -29,7 +31,7 @@ from __future__ import annotations
 
 from .. import gf
 from .floats import f32, jitter_value, sample_value
-from .hashes import MASK, block_seed, dimension_seeds, permute, randfloat
+from .hashes import MASK, dimension_seeds, locate, permute, randfloat
 
 #: Offset styles of docs/spec.md section 4, in the order of their kernel codes.
 OFFSETS = ("centered", "j", "mj", "cmj")
@@ -49,16 +51,6 @@ def _check_common(i: int, N: int, j: int, p: int, offset: str, jitter: float) ->
     return f32(jitter)
 
 
-def _column(i: int, N: int, j: int, dmax: int, p: int, offset: str, jitter: float):
-    """Checks the arguments, then applies the block rule (docs/spec.md section 6):
-    dimension ``j`` is column ``j % dmax`` of the copy with seed
-    ``block_seed(p, j // dmax)``. Returns the float32 jitter amount, the
-    column and its three seeds (stratum, sub-stratum, jitter)."""
-    J = _check_common(i, N, j, p, offset, jitter)
-    block, col = divmod(j, dmax)
-    return J, col, dimension_seeds(block_seed(p, block), col)
-
-
 def _centered(M: int) -> float:
     # (M-1)/2 is an integer or a half-integer below 2**23: exact in float32.
     return (M - 1) / 2
@@ -69,20 +61,36 @@ def _offset_sub(offset: str, u: int, M: int, cell_key: int, aij: int, P2: int) -
     coarse stratum, in ``[0, M)``) permuted with a seed per cell (``j``:
     ``cell_key * P2``), per stratum (``mj``: ``(A_ij + 1) * P2``) or per
     column (``cmj``: ``P2``); ``centered`` is ``(M - 1) / 2``. ``cell_key`` is
-    ``A_ik s + A_ij + 1`` for Bose and ``i + 1`` for the other constructions."""
+    ``A_ik s + A_ij + 1`` for Bose and ``row + 1`` for the other constructions."""
     if offset == "centered":
         return _centered(M)
     seed = {"j": cell_key * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset]
     return permute(u, M, seed & MASK)
 
 
-def _value(i: int, aij: int, u: int, P1: int, P2: int, P3: int, s: int, M: int, offset: str, J: float, cell_key: int) -> float:
-    """``x`` of sample ``i`` in cell ``(A_ij, u)``: stratum ``permute(A_ij, s, P1)``,
-    the offset's sub-stratum (:func:`_offset_sub`) among ``M`` and the jitter
-    of amount ``J`` seeded by ``P3`` (docs/spec.md sections 1 and 4)."""
+def oa_value(i: int, j: int, p: int, offset: str, jitter: float, *, N: int, B: int, s: int, M: int, cell) -> float:
+    """``x(i, j)`` of an orthogonal array with ``N`` rows, ``B`` columns, ``s``
+    symbols and ``M = N / s`` sub-strata, seed ``p``: the frame every
+    construction shares.
+
+    The block rule (:func:`~.hashes.locate`, docs/spec.md section 6) gives
+    the copy's seed ``P``, the row and the column; ``cell(row, col)`` (the
+    construction's only part) gives ``(A_ij, u, cell_key)``; then the common
+    tail of docs/spec.md section 5.2::
+
+        stratum = permute(A_ij, s, P1)
+        sub     = section 4's offset (from u, M, cell_key, A_ij, P2)
+        x       = (stratum + (sub + jitter(randfloat(row, P3))) / M) / s
+
+    with ``(P1, P2, P3)`` the column's seeds (:func:`~.hashes.dimension_seeds`).
+    """
+    J = _check_common(i, N, j, p, offset, jitter)
+    P, row, col = locate(p, i, j, B, N)
+    aij, u, cell_key = cell(row, col)
+    P1, P2, P3 = dimension_seeds(P, col)
     stratum = permute(aij, s, P1)
     sub = _offset_sub(offset, u, M, cell_key, aij, P2)
-    return sample_value(stratum, sub, jitter_value(randfloat(i, P3), J), M, s)
+    return sample_value(stratum, sub, jitter_value(randfloat(row, P3), J), M, s)
 
 
 def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.0) -> float:
@@ -112,9 +120,11 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
     """
     if not gf.is_supported(s):
         raise ValueError(f"bose needs s prime or a prime power <= {gf.MAX_TABLE_Q}, got s={s}")
-    J, col, (P1, P2, P3) = _column(i, s * s, j, s + 1, p, offset, jitter)
-    aij, aik = bose_cell(i, col, s)
-    return _value(i, aij, aik, P1, P2, P3, s, s, offset, J, aik * s + aij + 1)
+    def cell(row, col):
+        aij, aik = bose_cell(row, col, s)
+        return aij, aik, aik * s + aij + 1  # the 'j' offset's key is the (A_ij, A_ik) cell
+
+    return oa_value(i, j, p, offset, jitter, N=s * s, B=s + 1, s=s, M=s, cell=cell)
 
 
 def bose_cell(i: int, col: int, s: int) -> tuple[int, int]:
@@ -154,10 +164,8 @@ def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: f
     """
     if s < 2 or t < 1:
         raise ValueError(f"cmjnd needs s >= 2 and t >= 1, got s={s}, t={t}")
-    N = s**t
-    J, col, (P1, P2, P3) = _column(i, N, j, t, p, offset, jitter)
-    aij, v = cmjnd_cell(i, col, s)
-    return _value(i, aij, v, P1, P2, P3, s, N // s, offset, J, i + 1)
+    return oa_value(i, j, p, offset, jitter, N=s**t, B=t, s=s, M=s ** (t - 1),
+                    cell=lambda row, col: (*cmjnd_cell(row, col, s), row + 1))
 
 
 def cmjnd_cell(i: int, col: int, s: int) -> tuple[int, int]:
@@ -206,10 +214,8 @@ def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: fl
     """
     if not gf.is_supported(s) or not 2 <= t <= s:
         raise ValueError(f"bush needs s prime or a prime power <= {gf.MAX_TABLE_Q} and 2 <= t <= s, got s={s}, t={t}")
-    N = s**t
-    J, col, (P1, P2, P3) = _column(i, N, j, s + 1, p, offset, jitter)
-    aij, u = bush_cell(i, col, s, t)
-    return _value(i, aij, u, P1, P2, P3, s, N // s, offset, J, i + 1)
+    return oa_value(i, j, p, offset, jitter, N=s**t, B=s + 1, s=s, M=s ** (t - 1),
+                    cell=lambda row, col: (*bush_cell(row, col, s, t), row + 1))
 
 
 def bush_cell(i: int, col: int, s: int, t: int) -> tuple[int, int]:
@@ -260,10 +266,8 @@ def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jit
     pr = gf.prime_power(q)
     if pr is None or pr[0] == 2 or not gf.is_supported(q):
         raise ValueError(f"addelman-kempthorne needs q an odd prime, or odd prime power <= {gf.MAX_TABLE_Q}, got {q}")
-    N = 2 * q * q
-    J, col, (P1, P2, P3) = _column(i, N, j, 2 * q + 1, p, offset, jitter)
-    aij, u = addelman_kempthorne_cell(i, col, q)
-    return _value(i, aij, u, P1, P2, P3, q, 2 * q, offset, J, i + 1)
+    return oa_value(i, j, p, offset, jitter, N=2 * q * q, B=2 * q + 1, s=q, M=2 * q,
+                    cell=lambda row, col: (*addelman_kempthorne_cell(row, col, q), row + 1))
 
 
 def addelman_kempthorne_cell(i: int, col: int, q: int) -> tuple[int, int]:
@@ -311,10 +315,8 @@ def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float
     """
     if s < 2 or s & (s - 1) or 2 * s > gf.MAX_TABLE_Q:
         raise ValueError(f"bose-bush needs s a power of two with 2 <= s <= {gf.MAX_TABLE_Q // 2}, got {s}")
-    N = 2 * s * s
-    J, col, (P1, P2, P3) = _column(i, N, j, 2 * s + 1, p, offset, jitter)
-    aij, u = bose_bush_cell(i, col, s)
-    return _value(i, aij, u, P1, P2, P3, s, 2 * s, offset, J, i + 1)
+    return oa_value(i, j, p, offset, jitter, N=2 * s * s, B=2 * s + 1, s=s, M=2 * s,
+                    cell=lambda row, col: (*bose_bush_cell(row, col, s), row + 1))
 
 
 def bose_bush_cell(i: int, col: int, s: int) -> tuple[int, int]:

@@ -1,5 +1,8 @@
 """The OpenCL C functions of kernels/*.cl, called one by one through a small test
-kernel built with pyoa's own source and build options, against the C oracle."""
+kernel built with pyoa's own source and build options, against the C oracle.
+The orthogonal arrays are called through ``oa_dispatch`` (the block rule, the
+construction's cell and the common tail), with each construction's B, N and
+M written out here from docs/spec.md section 1.4."""
 
 from __future__ import annotations
 
@@ -34,11 +37,14 @@ __kernel void t_bose(__global const uint *i, __global const uint *j, const uint 
                      const uint offset, const float J, __global float *out)
 { size_t g = get_global_id(0);
   /* prime s only (the C oracle's domain): tabled = 0, so the GF placeholder is never used */
-  out[g] = bose(i[g], j[g], s, p[g], offset, J, (__global const ushort *)p, 0u); }
+  out[g] = oa_dispatch(CONSTRUCTION_BOSE, i[g], j[g], s, 2u, s + 1u, s * s, s, p[g], offset, J,
+                       (__global const ushort *)p, 0u, p); }
 
 __kernel void t_cmjnd(__global const uint *i, __global const uint *j, const uint s, const uint t,
                       __global const uint *p, const uint offset, const float J, __global float *out)
-{ size_t g = get_global_id(0); out[g] = cmjnd(i[g], j[g], s, t, p[g], offset, J); }
+{ size_t g = get_global_id(0);
+  out[g] = oa_dispatch(CONSTRUCTION_CMJND, i[g], j[g], s, t, t, pow_u(s, t), pow_u(s, t - 1u), p[g], offset, J,
+                       (__global const ushort *)p, 0u, p); }
 
 __kernel void t_gf(__global const uint *a, __global const uint *b, const uint q, __global const ushort *gf,
                    const uint tabled, __global uint *sum, __global uint *prod)
@@ -47,23 +53,30 @@ __kernel void t_gf(__global const uint *a, __global const uint *b, const uint q,
 __kernel void t_bose_gf(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
                         const uint offset, const float J, __global const ushort *gf, const uint tabled,
                         __global float *out)
-{ size_t g = get_global_id(0); out[g] = bose(i[g], j[g], s, p[g], offset, J, gf, tabled); }
+{ size_t g = get_global_id(0);
+  out[g] = oa_dispatch(CONSTRUCTION_BOSE, i[g], j[g], s, 2u, s + 1u, s * s, s, p[g], offset, J, gf, tabled, p); }
 
 __kernel void t_bush(__global const uint *i, __global const uint *j, const uint s, const uint t,
                      __global const uint *p, const uint offset, const float J, __global const ushort *gf,
                      const uint tabled, __global float *out)
-{ size_t g = get_global_id(0); out[g] = bush(i[g], j[g], s, t, p[g], offset, J, gf, tabled); }
+{ size_t g = get_global_id(0);
+  out[g] = oa_dispatch(CONSTRUCTION_BUSH, i[g], j[g], s, t, s + 1u, pow_u(s, t), pow_u(s, t - 1u), p[g], offset, J,
+                       gf, tabled, p); }
 
 __kernel void t_addelman_kempthorne(__global const uint *i, __global const uint *j, const uint s,
                                     __global const uint *p, const uint offset, const float J,
                                     __global const ushort *gf, const uint tabled, __global const uint *ak,
                                     __global float *out)
-{ size_t g = get_global_id(0); out[g] = addelman_kempthorne(i[g], j[g], s, p[g], offset, J, gf, tabled, ak); }
+{ size_t g = get_global_id(0);
+  out[g] = oa_dispatch(CONSTRUCTION_ADDELMAN_KEMPTHORNE, i[g], j[g], s, 2u, 2u * s + 1u, 2u * s * s, 2u * s, p[g],
+                       offset, J, gf, tabled, ak); }
 
 __kernel void t_bose_bush(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
                           const uint offset, const float J, __global const ushort *gf, const uint tabled,
                           __global float *out)
-{ size_t g = get_global_id(0); out[g] = bose_bush(i[g], j[g], s, p[g], offset, J, gf, tabled); }
+{ size_t g = get_global_id(0);
+  out[g] = oa_dispatch(CONSTRUCTION_BOSE_BUSH, i[g], j[g], s, 2u, 2u * s + 1u, 2u * s * s, 2u * s, p[g], offset, J,
+                       gf, tabled, p); }
 
 __kernel void t_ak_cell(__global const uint *i, __global const uint *j, const uint q, __global const ushort *gf,
                         const uint tabled, __global const uint *ak, __global uint *aij, __global uint *u)

@@ -1,8 +1,13 @@
 /* An independent C implementation of docs/spec.md sections 2, 3, 5 (Bose, CMJND),
  * 6 and 7, written from the specification text (and, for mix32 / hash_pair /
- * pixel_seed / block_seed, from the documented choices in the docstrings of
- * pyoa/reference/hashes.py: Wellons' lowbias32 and hash_pair(a, b, key) =
+ * pixel_seed / block_seed / block_order_seed, from the documented choices in the
+ * docstrings of pyoa/reference/hashes.py: Wellons' lowbias32 and hash_pair(a, b, key) =
  * lowbias32(b ^ lowbias32(a ^ key)), 0 -> key), NOT from pyoa's code.
+ *
+ * The block rule (section 6): dimension j of sample i, in an array of N rows and B
+ * columns per block with seed p, is column j % B of the copy with seed
+ * P = block_seed(p, j / B), read at row permute(permute(i, N, r), N, mix32(r)), r = block_order_seed(P, j / B, N):
+ * the OA cell, the 'j' offset's cell key and the jitter's randfloat all use that row.
  *
  * The test suite compiles it at test time:
  *     cc -std=c99 -O2 -ffp-contract=off -o spec_hashes spec_hashes.c
@@ -13,6 +18,7 @@
  *     X x                     -> mix32(x)
  *     S seed pixel            -> pixel_seed(seed, pixel)
  *     B p block               -> block_seed(p, block)
+ *     K P block N             -> block_order_seed(P, block, N)         (P: the block's seed)
  *     O i j s p off Jbits     -> bits of the Bose value x(i, j)        (off: 0 centered, 1 j, 2 mj, 3 cmj)
  *     C i j s t p off Jbits   -> bits of the CMJND value x(i, j)       (Jbits: float32 bits of the jitter amount)
  *
@@ -87,6 +93,20 @@ static u32 hash_pair(u32 a, u32 b, u32 key)
 
 static u32 pixel_seed(u32 seed, u32 pixel) { return hash_pair(seed, pixel, 0x5bd1e995u); }
 static u32 block_seed(u32 p, u32 block) { return block == 0 ? p : hash_pair(p, block, 0x1b873593u); }
+/* the sample order of a block (section 6): block 0 keeps its rows (permute with seed 0 is the identity) */
+static u32 block_order_seed(u32 P, u32 block, u32 N) { return block == 0 ? 0 : hash_pair(P, N, 0x94d049bbu); }
+
+/* docs/spec.md section 6, the block rule: dimension j of sample i of an array with N
+ * rows, B columns per block and seed p reads column *col of the copy with seed *P,
+ * at row permute(permute(i, N, r), N, mix32(r)), r = block_order_seed(*P, block, N) (returned) */
+static u32 locate(u32 p, u32 i, u32 j, u32 B, u32 N, u32 *P, u32 *col)
+{
+    u32 block = j / B;
+    *col = j % B;
+    *P = block_seed(p, block);
+    u32 r = block_order_seed(*P, block, N);
+    return permute(permute(i, N, r), N, mix32(r));
+}
 
 /* x * n compared with c exactly, in integers (docs/spec.md section 7): x = m 2^-e with
  * m its 24-bit significand, so x * n < c iff m n < c 2^e; m n < 2^49, and for
@@ -132,17 +152,17 @@ static float value(u32 stratum, float sub, u32 i, u32 P3, float J, u32 M, u32 s)
 
 enum { CENTERED = 0, JITTERED = 1, MJ = 2, CMJ = 3 };
 
-/* docs/spec.md section 5, Bose; section 6 blocks of s+1 columns */
+/* docs/spec.md section 5, Bose; section 6 blocks of s+1 columns, N = s^2 rows:
+ * the block rule gives the row to read, and from here on j is its column, p the block's seed */
 static float bose(u32 i, u32 j, u32 s, u32 p, int off, float J)
 {
-    u32 block = j / (s + 1), a0, a1, aij, aik, k, P1, P2, P3, stratum;
+    u32 row, a0, a1, aij, aik, k, P1, P2, P3, stratum;
     float sub;
-    j = j % (s + 1);
-    p = block_seed(p, block);
+    row = locate(p, i, j, s + 1, s * s, &p, &j);
     P1 = p * (j + 1) * 0x51633e2du;
     P2 = p * (j + 1) * 0x68bc21ebu;
     P3 = p * (j + 1) * 0x02e5be93u;
-    a0 = i / s; a1 = i % s;
+    a0 = row / s; a1 = row % s;
     if (j == 0) { aij = a0; aik = a1; }
     else if (j == 1) { aij = a1; aik = a0; }
     else {
@@ -157,24 +177,24 @@ static float bose(u32 i, u32 j, u32 s, u32 p, int off, float J)
     case MJ:       sub = (float)permute(aik, s, (aij + 1) * P2); break;
     default:       sub = (float)permute(aik, s, P2); break;
     }
-    return value(stratum, sub, i, P3, J, s, s);
+    return value(stratum, sub, row, P3, J, s, s);
 }
 
-/* docs/spec.md section 5, CMJND; section 6 blocks of t columns */
+/* docs/spec.md section 5, CMJND; section 6 blocks of t columns, N = s^t rows:
+ * the block rule gives the row to read, and from here on j is its column, p the block's seed */
 static float cmjnd(u32 i, u32 j, u32 s, u32 t, u32 p, int off, float J)
 {
-    u32 block = j / t, M = 1, sj = 1, d, aij, v, P1, P2, P3, stratum, c, pw;
+    u32 row, M = 1, sj = 1, d, aij, v, P1, P2, P3, stratum, c, pw;
     float sub;
-    j = j % t;
-    p = block_seed(p, block);
+    for (d = 0; d + 1 < t; ++d) M *= s;
+    row = locate(p, i, j, t, M * s, &p, &j);
     P1 = p * (j + 1) * 0x51633e2du;
     P2 = p * (j + 1) * 0x68bc21ebu;
     P3 = p * (j + 1) * 0x02e5be93u;
-    for (d = 0; d + 1 < t; ++d) M *= s;
     for (d = 0; d < j; ++d) sj *= s;
-    aij = (i / sj) % s;
+    aij = (row / sj) % s;
     /* v: the other t-1 digits in their order, lowest remaining digit least significant */
-    v = 0; pw = 1; c = i;
+    v = 0; pw = 1; c = row;
     for (d = 0; d < t; ++d) {
         u32 digit = c % s;
         c /= s;
@@ -185,11 +205,11 @@ static float cmjnd(u32 i, u32 j, u32 s, u32 t, u32 p, int off, float J)
     stratum = permute(aij, s, P1);
     switch (off) {
     case CENTERED: sub = (float)(M - 1) / 2.0f; break;
-    case JITTERED: sub = (float)permute(v, M, (i + 1) * P2); break;
+    case JITTERED: sub = (float)permute(v, M, (row + 1) * P2); break;
     case MJ:       sub = (float)permute(v, M, (aij + 1) * P2); break;
     default:       sub = (float)permute(v, M, P2); break;
     }
-    return value(stratum, sub, i, P3, J, M, s);
+    return value(stratum, sub, row, P3, J, M, s);
 }
 
 int main(void)
@@ -208,6 +228,8 @@ int main(void)
                   printf("%lu\n", (unsigned long)pixel_seed((u32)a, (u32)b)); break;
         case 'B': sscanf(line + 1, "%lu %lu", &a, &b);
                   printf("%lu\n", (unsigned long)block_seed((u32)a, (u32)b)); break;
+        case 'K': sscanf(line + 1, "%lu %lu %lu", &a, &b, &c);
+                  printf("%lu\n", (unsigned long)block_order_seed((u32)a, (u32)b, (u32)c)); break;
         case 'O': sscanf(line + 1, "%lu %lu %lu %lu %lu %lu", &a, &b, &c, &d, &e, &f);
                   printf("%lu\n", (unsigned long)to_bits(bose((u32)a, (u32)b, (u32)c, (u32)d, (int)e,
                                                               from_bits((u32)f)))); break;

@@ -20,7 +20,7 @@ import pytest
 
 from pyoa._numpy import oa as noa
 from pyoa.reference import oa as roa
-from pyoa.reference.hashes import block_seed, dimension_seeds, permute
+from pyoa.reference.hashes import BLOCK_ORDER_KEY, block_seed, dimension_seeds, hash_pair, mix32, permute
 from tests.helpers import assert_oa
 
 U32 = np.uint32
@@ -156,8 +156,10 @@ def test_public_samplers_sit_in_their_cell(case):
     for p in [0, 0x9E3779B9]:
         for j in range(2 * case.d):
             block, col = divmod(j, case.d)
-            P1, P2, _ = dimension_seeds(block_seed(p, block), col)
+            P = block_seed(p, block)
+            P1, P2, _ = dimension_seeds(P, col)
+            order = hash_pair(P, case.N, BLOCK_ORDER_KEY) if block else 0  # docs/spec.md section 6
             for i in range(case.N):
-                a, u = case.ref_cell(i, col)
+                a, u = case.ref_cell(permute(permute(i, case.N, order), case.N, mix32(order)), col)
                 want = permute(a, case.s, P1) * case.M + permute(u, case.M, P2)
                 assert math.floor(case.value(i, j, p) * case.N) == want, f"{case}: i={i}, j={j}, seed {p}"

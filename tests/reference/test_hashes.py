@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pyoa import reference as ref
-from pyoa.reference.hashes import hash_pair
+from pyoa.reference.hashes import block_order_seed, hash_pair
 from tests.helpers import (
     BLOCK_KEY,
     BOSE_PRIMES,
@@ -131,6 +131,22 @@ def test_mix32_pixel_seed_block_seed_match_c_oracle(spec_c):
     assert [ref.mix32(x) for x in a] == spec_c.mix32(a)
     assert [ref.pixel_seed(x, y) for x, y in cases] == spec_c.pixel_seed(a, b)
     assert [ref.block_seed(x, y) for x, y in cases] == spec_c.block_seed(a, b)
+
+
+def test_block_order_seed_matches_c_oracle(spec_c):
+    """block_order_seed(P, block, N) of docs/spec.md section 6 (command K of spec_hashes.c):
+    0 for block 0, else hash_pair(P, N, 0x94d049bb), never 0."""
+    rng = np.random.default_rng(11)
+    specials = [0, 1, 2, 0x1B873593, 0x94D049BB, U32_MAX - 1, U32_MAX]
+    Ns = [1, 2, 4, 64, 121, 169, 2**24, 2**31]
+    cases = [(P, block, N) for P in specials for block in range(4) for N in Ns]
+    cases += [(int(P), int(block), int(N)) for P, block, N in
+              zip(rng.integers(0, 2**32, 500), rng.integers(0, 2**32, 500), rng.integers(1, 2**31 + 1, 500))]
+    want = spec_c.query([f"K {P} {block} {N}" for P, block, N in cases])
+    got = [block_order_seed(P, block, N) for P, block, N in cases]
+    bad = [(c, g, w) for c, g, w in zip(cases, got, want) if g != w]
+    assert not bad, f"{len(bad)} mismatches, first (P, block, N), got, want: {bad[:5]}"
+    assert all((w == 0) == (block == 0) for (_, block, _), w in zip(cases, want))
 
 
 # ----------------------------------------------------------------------------- permute properties

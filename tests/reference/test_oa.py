@@ -21,6 +21,7 @@ import pyoa
 from pyoa import reference as ref
 from pyoa._numpy import oa as noa
 from pyoa.reference.floats import jitter_value, sample_value
+from pyoa.reference.hashes import hash_pair
 from tests.helpers import (
     AK_Q,
     BB_S,
@@ -77,6 +78,78 @@ def test_reference_values_match_c_oracle(spec_c):
     got = [int(np.float32(ref.cmjnd(*r)).view(np.uint32)) for r in rows]
     bad = [(r, g, w) for r, g, w in zip(rows, got, want) if g != w]
     assert not bad, f"{len(bad)} cmjnd mismatches: {bad[:3]}"
+
+
+def _block_rule_seeds(spec_c):
+    """Array seeds for the block-rule comparisons, as (C's seed, Python's seed): plain
+    seeds, and pixel seeds of pixels near 2**32 (C's from its own pixel_seed, command
+    S; Python's from pyoa.reference.pixel_seed)."""
+    plain = [0, 1, 0x9E3779B9, U32_MAX - 1, U32_MAX]
+    pixels = [(0, U32_MAX), (U32_MAX, U32_MAX), (U32_MAX, U32_MAX - 1), (12345, 2**32 - 7)]
+    c_pix = spec_c.pixel_seed(*zip(*pixels))
+    return [(p, p) for p in plain] + [(c, ref.pixel_seed(seed, pix)) for c, (seed, pix) in zip(c_pix, pixels)]
+
+
+def _compare_bits(rows_c, rows_py, c_query, py_fn, what):
+    want = c_query(rows_c)
+    got = [int(np.float32(py_fn(*r)).view(np.uint32)) for r in rows_py]
+    bad = [(r, hex(g), hex(w)) for r, g, w in zip(rows_py, got, want) if g != w]
+    assert not bad, f"{len(bad)} of {len(rows_py)} {what} mismatches, first (args), got, want: {bad[:3]}"
+
+
+@pytest.mark.parametrize("jitter", [0.0, 1.0, 0.375])
+def test_block_rule_bose_matches_c_oracle(spec_c, jitter):
+    """docs/spec.md section 6's block rule, Bose s = 11 (12 columns a block): every
+    dimension of blocks 0-3, first, last and some middle samples, every offset, against
+    the C oracle (which permutes the rows of blocks >= 1 by block_order_seed)."""
+    s, dims = 11, range(48)
+    samples = [0, 1, 60, s * s - 2, s * s - 1]
+    rows_c, rows_py = [], []
+    for pc, pp in _block_rule_seeds(spec_c):
+        for i in samples:
+            for j in dims:
+                for off in OFFSETS:
+                    rows_c.append((i, j, s, pc, off, jitter))
+                    rows_py.append((i, j, s, pp, off, jitter))
+    _compare_bits(rows_c, rows_py, spec_c.bose_bits, ref.bose, "bose")
+
+
+@pytest.mark.parametrize("jitter", [0.0, 1.0, 0.375])
+def test_block_rule_cmjnd_matches_c_oracle(spec_c, jitter):
+    """As above for CMJND s = 4, t = 3 (3 columns a block, 64 rows): dimensions
+    0-11 (blocks 0-3), every sample, every offset; and s = 3, t = 1 (one column
+    a block) for dimensions 0-7."""
+    rows_c, rows_py = [], []
+    for s, t, dims in [(4, 3, range(12)), (3, 1, range(8))]:
+        for pc, pp in _block_rule_seeds(spec_c):
+            for i in range(s**t):
+                for j in dims:
+                    for off in OFFSETS:
+                        rows_c.append((i, j, s, t, pc, off, jitter))
+                        rows_py.append((i, j, s, t, pp, off, jitter))
+    _compare_bits(rows_c, rows_py, spec_c.cmjnd_bits, ref.cmjnd, "cmjnd")
+
+
+def test_block_rule_reorders_later_blocks(spec_c):
+    """The C oracle's rows: block 0 reads row i (block_order_seed 0), blocks 1-3 a
+    permutation of the rows that is not the identity, different per block and seed;
+    so the comparisons above would see the old rule (row i in every block)."""
+    from pyoa.reference.hashes import locate
+
+    for N, B in [(121, 12), (64, 3)]:
+        for p in [0, 1, U32_MAX]:
+            P = spec_c.block_seed([p] * 4, range(4))
+            K = spec_c.query([f"K {P[b]} {b} {N}" for b in range(4)])
+            assert K[0] == 0 and all(K[1:])
+            once = [spec_c.permute(range(N), [N] * N, [K[b]] * N) for b in range(4)]
+            second = spec_c.mix32(K)  # block_row: a second permutation, seeded mix32(r)
+            orders = [spec_c.permute(once[b], [N] * N, [second[b]] * N) for b in range(4)]
+            assert orders[0] == list(range(N))
+            for b in range(1, 4):
+                assert sorted(orders[b]) == list(range(N)) and orders[b] != list(range(N))
+                assert orders[b] not in orders[:b]
+                # the Python reference's block rule reads the same rows
+                assert [locate(p, i, b * B + 1, B, N) for i in range(N)] == [(P[b], r, 1) for r in orders[b]]
 
 
 # ----------------------------------------------------------------------------- canonical arrays (p = 0)
@@ -318,12 +391,25 @@ def test_integer_mod_q_is_not_an_oa_for_prime_powers(q):
         assert_oa(A, q, 2)
 
 
+def _block_rule(p, i, j, B, N):
+    """docs/spec.md section 6, written out with pyoa's hash primitives only (not
+    reference.hashes.locate): ``(P, row, col)``, the copy's seed, the row that
+    sample ``i`` reads (``row = i`` in block 0, else permuted with seed
+    ``hash_pair(P, N, 0x94d049bb)``) and the column."""
+    block, col = divmod(j, B)
+    P = ref.block_seed(p, block)
+    r = hash_pair(P, N, 0x94D049BB)
+    row = i if block == 0 else ref.permute(ref.permute(i, N, r), N, ref.mix32(r))
+    return P, row, col
+
+
 def _bose_from_symbols(i, j, q, p, offset, jitter, symbol, partner):
     """docs/spec.md section 5 Bose value from independently computed symbols: ``symbol``
     and ``partner`` give A_ij and A_ik of column ``j < q+1``; seeds, offsets and
-    floats use pyoa's hash and float primitives only."""
-    block, j = divmod(j, q + 1)
-    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    floats use pyoa's hash and float primitives only; the block rule of section 6
+    by :func:`_block_rule`."""
+    P, i, j = _block_rule(p, i, j, q + 1, q * q)
+    P1, P2, P3 = ref.dimension_seeds(P, j)
     aij, aik = symbol(i, j), partner(i, j)
     stratum = ref.permute(aij, q, P1)
     if offset == "centered":
@@ -367,8 +453,8 @@ def _bush_from_spec(i, j, s, t, p, offset, jitter):
     with the independent field of tests.helpers."""
     F = field_for(s)
     M = s ** (t - 1)
-    block, j = divmod(j, s + 1)
-    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    P, i, j = _block_rule(p, i, j, s + 1, s**t)
+    P1, P2, P3 = ref.dimension_seeds(P, j)
     aij, u = bush_symbol(i, j, t, F), bush_sub_index(i, j, s, t)
     stratum = ref.permute(aij, s, P1)
     if offset == "centered":
@@ -630,10 +716,10 @@ def test_index2_last_column_adds_only_triple_coincidences(name, s):
 def _index2_from_spec(name, i, j, s, p, offset, jitter):
     """One value of an index-2 sampler written out from the docstrings of
     reference.addelman_kempthorne / bose_bush, with the independent plain arrays:
-    blocks of 2s+1 columns, M = 2s, the 'j' seed (i + 1) P2."""
+    blocks of 2s+1 columns, M = 2s, the 'j' seed (row + 1) P2 (the row of :func:`_block_rule`)."""
     M = 2 * s
-    block, j = divmod(j, 2 * s + 1)
-    P1, P2, P3 = ref.dimension_seeds(ref.block_seed(p, block), j)
+    P, i, j = _block_rule(p, i, j, 2 * s + 1, 2 * s * s)
+    P1, P2, P3 = ref.dimension_seeds(P, j)
     aij, u = index2_symbol(name, i, j, s)
     stratum = ref.permute(aij, s, P1)
     if offset == "centered":
