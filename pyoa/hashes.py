@@ -16,7 +16,8 @@ Functions
 :func:`pixel_seed`
     The point-set seed of one pixel (docs/spec.md section 3).
 :func:`block_seed`
-    The seed of one independently randomized copy of an array (section 6).
+    The seed of one independently randomized copy of an array (section 6;
+    the copy's order of the rows is keyed by it too).
 
 Examples
 --------

@@ -72,9 +72,10 @@ class OrthogonalArray(qmc.QMCEngine):
     d : int
         Dimension of the parameter space, ``1 <= d <= 2**20``. Dimensions past
         one block of the construction (``block_dims``: ``s + 1`` for ``bose``)
-        come from independently randomized copies of the array: every t of
-        them inside one block are jointly stratified, two from different
-        blocks are only Latin hypercube against Latin hypercube.
+        come from independently randomized copies of the array, each read in
+        its own random order of the rows: every t of them inside one block
+        are jointly stratified, two from different blocks are two
+        stratified coordinates paired at random (docs/spec.md section 6).
     spp : int, optional
         Points per array, N: a count valid for `sampler` (``s**2`` with s a
         prime or prime power for ``bose``; see :func:`pyoa.valid_spp`). An

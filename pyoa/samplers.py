@@ -698,7 +698,8 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         nearest valid ones.
     dims : int
         Number of dimensions, ``1 <= dims <= 2**20``. Dimensions past one
-        block come from independently randomized copies of the array.
+        block come from independently randomized copies of the array, each
+        read in its own random order of the rows (docs/spec.md section 6).
     seed : int
         User seed in ``[0, 2**32)``; out-of-range seeds are refused, not reduced.
         Pixel ``k`` uses the array seed ``pyoa.reference.pixel_seed(seed, k)``.
