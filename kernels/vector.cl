@@ -10,6 +10,7 @@
  *   VDMAX           dimensions per block (docs/spec.md section 6)
  *   VN, VWN         rows N = s M of the array and the walk mask of N
  *   VLATER          1: some dimension lies past block 0 (its own rows)
+ *   VGROUPED        1: more than 16 dimensions, computed and stored in groups of 8
  *   VOFFSET         the offset's code (OFFSET_* of pyoa.constructions)
  *   VS_PACKED       1: the stratum permutation is tabled as 4-bit fields
  *                   (s <= 16); 0: each value walks it (VS_ROUNDS rounds)
@@ -147,15 +148,103 @@ __kernel void vector_tables(__global uint *restrict pk,
     }
 }
 
+/* The value of dimension d (index into the request's dims) at sample
+ * positions [8 b, 8 b + 8) of pixel pl: lanes r of the result. i holds the
+ * sample indices. cell_a and cell_u are the cells of docs/spec.md section 5
+ * at the sample indices, laid out [d][k] with rows of VNKP
+ * (pyoa.host_tables.cells, padded): block 0's rows. A dimension of a later
+ * block (VLATER: the request has one) reads its copy at its own rows
+ * (docs/spec.md section 6): the row permutation is walked once per block and
+ * 8 samples (*last_order, *later_row carry it from one dimension to the
+ * next of the same block), and its cells are gathered from every row's
+ * cells, array_a and array_u, laid out [d][row] (pyoa.host_tables.array_cells). */
+static inline __attribute__((always_inline)) float8 value_v8(
+    uint d, uint b, uint pl, uint8 i, float J,
+    __global const uint *restrict pk, __global const uint *restrict cell_a, __global const uint *restrict cell_u,
+    __global const uint *restrict array_a, __global const uint *restrict array_u,
+    uint *last_order, uint8 *later_row)
+{
+    __global const uint *w = pk + 8u * (pl * VND + d);
+    uint8 aij = vload8(b, cell_a + d * VNKP);
+    uint8 row = i;
+#if VLATER
+    uint order = w[5];
+    if (order != 0u) {  /* a later block: its own rows (dimensions of one block share them) */
+        if (order != *last_order) {
+            *later_row = permute_walk_v8(permute_walk_v8(i, order, VN, VWN), mix32(order), VN, VWN);  /* block_row */
+            *last_order = order;
+        }
+        row = *later_row;
+        aij = gather_v8(array_a + d * VN, row);
+    }
+#endif
+#if VS_PACKED
+    uint8 stratum = field4_v8((uint8)w[0], (uint8)w[1], aij);
+#else
+    uint8 stratum = permute_bounded_v8(aij, (uint8)w[0], VS, VWS, VS_ROUNDS);
+#endif
+    float8 jit = jitter_value_v8(randfloat_v8(row, w[4]), J);
+#if VSUB == 0
+    return centered_value_v8(stratum, jit, VM, VS);
+#else
+    uint8 u = vload8(b, cell_u + d * VNKP);
+#if VLATER
+    if (order != 0u) u = gather_v8(array_u + d * VN, row);
+#endif
+#if VSUB == 1
+    uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
+#else
+#if VOFFSET == OFFSET_J
+#if VJKEY_BOSE
+    uint8 seed = (u * VS + aij + 1u) * w[2];
+#else
+    uint8 seed = (row + 1u) * w[2];
+#endif
+#elif VOFFSET == OFFSET_MJ
+    uint8 seed = (aij + 1u) * w[2];
+#else
+    uint8 seed = (uint8)w[2];
+#endif
+    uint8 sub = permute_bounded_v8(u, seed, VM, VWM, VSUB_ROUNDS);
+#endif
+    return sample_value_v8(stratum, sub, jit, VM, VS);
+#endif
+}
+
+#define VALUE_V8(d) value_v8((d), b, pl, i, J, pk, cell_a, cell_u, array_a, array_u, &last_order, &later_row)
+
+#if VGROUPED
+/* n (<= 8) dimensions from d0 of the 8 rows at o (row stride VND), `rows`
+ * of them valid: each row's n values are contiguous in the output, so a row
+ * of a full group is one vstore8 of a transposed lane (constant indices
+ * after unrolling: shuffles). */
+static inline __attribute__((always_inline)) void store_group(__global float *o, float8 *V, uint n, uint rows)
+{
+    #pragma unroll
+    for (uint r = 0u; r < 8u; ++r) {
+        if (r < rows) {
+            if (n == 8u) {
+                vstore8((float8)(((float *)&V[0])[r], ((float *)&V[1])[r], ((float *)&V[2])[r], ((float *)&V[3])[r],
+                                 ((float *)&V[4])[r], ((float *)&V[5])[r], ((float *)&V[6])[r], ((float *)&V[7])[r]),
+                        0, o + r * VND);
+            } else {
+                #pragma unroll
+                for (uint e = 0u; e < 8u; ++e)
+                    if (e < n) o[r * VND + e] = ((float *)&V[e])[r];
+            }
+        }
+    }
+}
+#endif
+
 /* Values of sample positions [8 b, 8 b + 8) of pixel pl (axis 0: b, axis 1:
- * pl), every dimension, written at out + out0 + (pl * VNK + 8 b) * VND. cell_a
- * and cell_u are the cells of docs/spec.md section 5 at the sample indices,
- * laid out [d][k] with rows of VNKP (pyoa.host_tables.cells, padded), isamp
- * the sample indices (padded): block 0's rows. A dimension of a later block
- * (VLATER: the request has one) reads its copy at its own rows
- * (docs/spec.md section 6): the row permutation is walked once per block
- * and 8 samples, and its cells are gathered from every row's cells, array_a
- * and array_u, laid out [d][row] (pyoa.host_tables.array_cells). */
+ * pl), every dimension, written at out + out0 + (pl * VNK + 8 b) * VND (see
+ * value_v8 for the arguments). Up to 16 dimensions (VGROUPED 0) the kernel
+ * holds one vector per dimension and stores whole rows (STORE_ROWS); more
+ * (VGROUPED 1) go in groups of 8 in a loop that is not unrolled, each
+ * stored as 8 row segments, so that no more than 8 vectors are live and the
+ * program stays the size of an 8-dimension one (a 46-dimension request,
+ * unrolled, took PoCL 9 s to compile and spilled). */
 __kernel void vector_values(__global float *restrict out,
                             const uint out0,
                             __global const uint *restrict pk,
@@ -168,60 +257,32 @@ __kernel void vector_values(__global float *restrict out,
 {
     uint b = (uint)get_global_id(0), pl = (uint)get_global_id(1);
     uint8 i = vload8(b, isamp);
-    float8 V[VND];
-#if VLATER
     uint last_order = 0u;
     uint8 later_row = i;
-#endif
-    #pragma unroll
-    for (uint d = 0u; d < VND; ++d) {  /* VND is a build constant: unrolled */
-        __global const uint *w = pk + 8u * (pl * VND + d);
-        uint8 aij = vload8(b, cell_a + d * VNKP);
-        uint8 row = i;
-#if VLATER
-        uint order = w[5];
-        if (order != 0u) {  /* a later block: its own rows (dimensions of one block share them) */
-            if (order != last_order) {
-                later_row = permute_walk_v8(permute_walk_v8(i, order, VN, VWN), mix32(order), VN, VWN);  /* block_row */
-                last_order = order;
-            }
-            row = later_row;
-            aij = gather_v8(array_a + d * VN, row);
-        }
-#endif
-#if VS_PACKED
-        uint8 stratum = field4_v8((uint8)w[0], (uint8)w[1], aij);
-#else
-        uint8 stratum = permute_bounded_v8(aij, (uint8)w[0], VS, VWS, VS_ROUNDS);
-#endif
-        float8 jit = jitter_value_v8(randfloat_v8(row, w[4]), J);
-#if VSUB == 0
-        V[d] = centered_value_v8(stratum, jit, VM, VS);
-#else
-        uint8 u = vload8(b, cell_u + d * VNKP);
-#if VLATER
-        if (order != 0u) u = gather_v8(array_u + d * VN, row);
-#endif
-#if VSUB == 1
-        uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
-#else
-#if VOFFSET == OFFSET_J
-#if VJKEY_BOSE
-        uint8 seed = (u * VS + aij + 1u) * w[2];
-#else
-        uint8 seed = (row + 1u) * w[2];
-#endif
-#elif VOFFSET == OFFSET_MJ
-        uint8 seed = (aij + 1u) * w[2];
-#else
-        uint8 seed = (uint8)w[2];
-#endif
-        uint8 sub = permute_bounded_v8(u, seed, VM, VWM, VSUB_ROUNDS);
-#endif
-        V[d] = sample_value_v8(stratum, sub, jit, VM, VS);
-#endif
+#if VGROUPED
+    __global float *o = out + out0 + (pl * VNK + 8u * b) * VND;
+    uint rows = ((VNK % 8u) != 0u && b + 1u == VNKP / 8u) ? VNK % 8u : 8u;
+    float8 V[8];
+    #pragma nounroll
+    for (uint g = 0u; g < VND / 8u; ++g) {
+        #pragma unroll
+        for (uint e = 0u; e < 8u; ++e)
+            V[e] = VALUE_V8(8u * g + e);
+        store_group(o + 8u * g, V, 8u, rows);
     }
+#if VND % 8u
+    #pragma unroll
+    for (uint e = 0u; e < VND % 8u; ++e)
+        V[e] = VALUE_V8(VND - VND % 8u + e);
+    store_group(o + (VND - VND % 8u), V, VND % 8u, rows);
+#endif
+#else
+    float8 V[VND];
+    #pragma unroll
+    for (uint d = 0u; d < VND; ++d)  /* VND is a build constant: unrolled */
+        V[d] = VALUE_V8(d);
     STORE_ROWS(V, b, pl);
+#endif
 }
 
 #endif  /* VBASELINE */

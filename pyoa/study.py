@@ -599,6 +599,10 @@ def run(args) -> int:
     write_settings(out / "study.json", settings)
     wanted = {j.ident for j in jobs}
     mine = [r for r in rows if (r["scene"], r["sampler"], r["spp_asked"], r["seed"]) in wanted]
+    # the report follows the command's order of scenes and samplers, not the order rows were rendered in
+    # (a resumed study appends the rows it renders after the ones it found)
+    place = {(s, n): k for k, (s, n) in enumerate((s, n) for s in loaded for n in names)}
+    mine.sort(key=lambda r: (place.get((r["scene"], r["sampler"]), len(place)), r["spp_asked"], r["seed"]))
     md = report(settings, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in settings["runs"]),
                 where=where)
     with atomic_path(out / "study.md") as tmp:

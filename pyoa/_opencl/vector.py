@@ -14,8 +14,13 @@ offset, when
 
 - a rectangle is whole pixels with at least 8 sample positions (the tables,
   32 bytes per pixel and dimension, are then no larger than the output),
-- there are at most :data:`MAX_DIMS` dimensions (the kernel holds one
-  vector per dimension),
+- there are at most :data:`MAX_DIMS` dimensions (up to
+  :data:`MAX_WHOLE_ROWS` the kernel holds one vector per dimension and
+  stores whole rows; more are computed and stored in groups of 8; the padded
+  2D samplers' kernel stops at :data:`MAX_WHOLE_ROWS`),
+- a dimension past the first block finds the cells of every row of the
+  array within :data:`pyoa.request.MAX_ARRAY_CELLS` (it reads its copy at its
+  own rows, docs/spec.md section 6),
 - the stratum permutation fits 4-bit fields (s <= 16) or its bounded walk
   takes at most :data:`MAX_ROUNDS` rounds, and the sub-stratum permutation
   likewise ('cmj' with M <= 16 is tabled; 'mj', 'j' and larger 'cmj' walk per
@@ -42,7 +47,10 @@ from ..request import Rect, Request
 #: Lanes per vector: 8 (AVX2's width; on AVX-512, 16 lanes measured slower).
 LANES = 8
 #: Most dimensions of a request on this path.
-MAX_DIMS = 16
+MAX_DIMS = 64
+#: Most dimensions the kernel holds as one vector each and stores as whole
+#: rows; more are computed in groups of 8 (kernels/vector.cl, VGROUPED).
+MAX_WHOLE_ROWS = 16
 #: Most rounds of a bounded walk (l = 17 in [0, 31] needs 16).
 MAX_ROUNDS = 16
 #: Words of the per-(pixel, dimension) table (kernels/vector.cl, vector_tables).
@@ -73,7 +81,8 @@ class _Rows:
         """``#define`` lines of ``consts`` and the row constants. The
         generated stores do not fit ``-D`` options, which the driver splits
         at spaces, so the constants open the program text instead."""
-        block, tail = store_code(self.n_dims, self.n_k % LANES)
+        # whole-row stores, for up to MAX_WHOLE_ROWS dimensions (more go in groups, without them)
+        block, tail = store_code(self.n_dims, self.n_k % LANES) if self.n_dims <= MAX_WHOLE_ROWS else (";", ";")
         consts = {**consts, "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
                   "VSTORE_BLOCK": block, "VSTORE_TAIL": tail}
         return "".join(f"#define {name} {value}\n" for name, value in consts.items())
@@ -113,6 +122,7 @@ class Shape(_Rows):
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
             "VN": f"{self.s * self.M}u", "VWN": f"{walk_mask(self.s * self.M)}u", "VLATER": int(self.later),
+            "VGROUPED": int(self.n_dims > MAX_WHOLE_ROWS),
         })
 
 
@@ -145,7 +155,7 @@ def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:
     """The vector program of a ``jittered2d`` or ``cmj2d`` rectangle, or None
     (other samplers, and the limits of :func:`shape`)."""
     kind = req.construction.vector_kind  # its catalogue entry names the kernel (VBASELINE), or 0
-    if not kind or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_DIMS:
+    if not kind or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_WHOLE_ROWS:
         return None
     a, b = req.construction.shape_args(req.params)
     shp = BaselineShape(kind, a, b, req.n_dims, rect.n_k)

@@ -72,6 +72,7 @@ from .integrands import (
     gaussian,
     halfspace,
     integrand,
+    lagged_pairs,
     oscillatory,
     pairwise,
 )
@@ -111,6 +112,7 @@ __all__ = [
     "latin_hypercube",
     "mean_ci",
     "oscillatory",
+    "lagged_pairs",
     "pairwise",
     "pass_variance",
     "radial_mean",

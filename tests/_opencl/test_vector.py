@@ -26,9 +26,10 @@ OFFSETS = ("cmj", "centered", "mj", "j")
 JITTERS = (1.0, 0.0, 12345677 * 2.0**-24)
 
 #: id -> (sampler arguments, requested dims). Every case has at least 8
-#: samples per pixel and at most 16 requested dimensions spanning several
-#: blocks, so with path="vector" every whole-pixel rectangle takes the vector
-#: path (asserted in test_paths_match_numpy).
+#: samples per pixel and at most MAX_DIMS requested dimensions spanning
+#: several blocks (later blocks read their own rows, docs/spec.md section 6),
+#: so with path="vector" every whole-pixel rectangle takes the vector path
+#: (asserted in test_paths_match_numpy).
 CASES = {
     # prime field, s = 11: stratum and 'cmj' sub-stratum tabled as 4-bit
     # fields; 121 = 15 blocks of 8 + a tail of 1; dims across blocks of 12
@@ -45,6 +46,11 @@ CASES = {
     "ak-q9": ({"name": "addelman-kempthorne", "spp": 162, "dims": 40}, [0, 18, 19, 38, 39, 4]),
     # s = 8, index 2: M = 16, the largest tabled sub-stratum permutation; blocks of 17
     "bose-bush-s8": ({"name": "bose-bush", "spp": 128, "dims": 35}, [0, 16, 17, 34, 9, 33]),
+    # more than 16 dimensions: groups of 8 (kernels/vector.cl, VGROUPED), here 4 of 8 and a
+    # tail group of 5 over blocks 0-3 of 12, in an order that returns to block 0
+    "bose-s11-grouped": ({"name": "bose", "spp": 121, "dims": 48}, [*range(20, 48), 0, 1, 2, 13, 5, 3, 30, 31, 47]),
+    # a whole grouped request (46 dimensions, like the 'deep' scene) of a walked sub-stratum
+    "bush-s5-t3-46": ({"name": "bush", "spp": 125, "strength": 3, "dims": 46}, None),
 }
 CASE_PIXELS = [0, 7, U32_MAX]
 
@@ -156,6 +162,10 @@ def test_vector_path_taken_where_expected():
     # MAX_DIMS dimensions: taken; one more: not
     assert shape_of("bose", 121, vector.MAX_DIMS + 5, req_dims=range(vector.MAX_DIMS)) is not None
     assert shape_of("bose", 121, vector.MAX_DIMS + 1) is None
+    # whole rows up to MAX_WHOLE_ROWS dimensions, groups of 8 beyond; later blocks flagged
+    assert "#define VGROUPED 0" in shape_of("bose", 121, vector.MAX_WHOLE_ROWS).header()
+    assert "#define VGROUPED 1" in shape_of("bose", 121, vector.MAX_WHOLE_ROWS + 1).header()
+    assert not shape_of("bose", 121, 12).later and shape_of("bose", 121, 13).later
     # a comparison sampler never
     assert shape_of("sobol", 64, 4) is None
     assert shape_of("halton", 64, 4) is None
