@@ -150,7 +150,15 @@ CASES: dict[str, dict] = {
                          about="Addelman-Kempthorne q=7 (index 2), correlated multi-jittered offsets"),
     "bosebush-cmj-128x10": dict(name="bose-bush", spp=128, dims=10, offset="cmj", strength=None,
                                 about="Bose-Bush s=8 in GF(16) (index 2), correlated multi-jittered offsets"),
+    # the blocks: 12 dimensions fill Bose s=11's first block; 36 are blocks 0-2, where later blocks read
+    # their own order of the rows (docs/spec.md section 6)
+    "bose-cmj-121x12": dict(name="bose", spp=121, dims=12, offset="cmj", strength=None,
+                            about="Bose s=11, cmj, 12 dimensions: one whole block"),
+    "bose-cmj-121x36": dict(name="bose", spp=121, dims=36, offset="cmj", strength=None,
+                            about="Bose s=11, cmj, 36 dimensions: blocks 0-2, each later block in its own row order"),
 }
+#: The blocks' cases (``--cases blocks``): the required one, one whole block and three blocks.
+BLOCK_CASES = ("bose-cmj-121x10", "bose-cmj-121x12", "bose-cmj-121x36")
 # Every comparison sampler of the catalogue (the paper's six, pbrt-v4's zsobol
 # and pmj02) and every progressive one (faure, at its default base: b=11 at
 # 121 spp and 10 dims, Bose's array size), at the count nearest 121, 10 dimensions.
@@ -425,6 +433,12 @@ def markdown(report: dict) -> str:
         )
     notes = [f"- {r['case']} / {r['backend']}: {r['status']}: {r['reason']}"
              for r in report["results"] if r["status"] != "ok"]
+    rate = {(r["case"], r["backend"]): r.get("median_values_per_s") for r in report["results"]}
+    for backend in ("opencl", "numpy"):
+        a, b = rate.get(("bose-cmj-121x36", backend)), rate.get(("bose-cmj-121x12", backend))
+        if a and b:
+            notes.append(f"- {backend}: 36 dimensions (blocks 0-2) at {a / b:.2f}x the values per second of 12 "
+                         "(one block), in this run")
     for case, same in report["bits_match"].items():
         notes.append(f"- {case}: backends gave {'identical' if same else 'DIFFERENT'} bits (BLAKE2b of the output)")
     if notes:
@@ -481,10 +495,12 @@ def parse_args(argv=None) -> argparse.Namespace:
                          "memory-bandwidth ceiling the 'of fill' column divides by (default: opencl,numpy,fill)")
     ap.add_argument("--cases", type=_csv(tuple(CASES), "case", extra={"all": tuple(CASES),
                                                                        "default": DEFAULT_CASES,
-                                                                       "baselines": BASELINE_CASES}),
+                                                                       "baselines": BASELINE_CASES,
+                                                                       "blocks": BLOCK_CASES}),
                     default="default",
                     help=f"comma-separated case names, 'default' ({', '.join(DEFAULT_CASES)}), "
-                         "'baselines' (the comparison and progressive samplers) or 'all' (see --list; "
+                         "'baselines' (the comparison and progressive samplers), 'blocks' (Bose 121 at 10, 12 "
+                         "and 36 dimensions: later blocks' own row orders) or 'all' (see --list; "
                          "default: default)")
     ap.add_argument("--repeats", type=int, default=5, help="timed runs after the warm-up (default: 5)")
     ap.add_argument("--pixels", type=int, default=None,

@@ -72,6 +72,12 @@ static inline __attribute__((always_inline)) uint8 permute_walk_v8(uint8 i, uint
     return (x >= l) ? x - l : x;
 }
 
+/* block_row (hashes.cl) of 8 samples of one block, order seed r != 0. */
+static inline __attribute__((always_inline)) uint8 block_row_v8(uint8 i, uint r)
+{
+    return permute_walk_v8(permute_walk_v8(i, r, VN, VWN), mix32(r), VN, VWN);
+}
+
 /* Lanes r of t[idx.sr]: a gather of 8 table entries. */
 static inline __attribute__((always_inline)) uint8 gather_v8(__global const uint *t, uint8 idx)
 {
@@ -171,7 +177,7 @@ static inline __attribute__((always_inline)) float8 value_v8(
     uint order = w[5];
     if (order != 0u) {  /* a later block: its own rows (dimensions of one block share them) */
         if (order != *last_order) {
-            *later_row = permute_walk_v8(permute_walk_v8(i, order, VN, VWN), mix32(order), VN, VWN);  /* block_row */
+            *later_row = block_row_v8(i, order);
             *last_order = order;
         }
         row = *later_row;

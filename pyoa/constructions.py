@@ -58,7 +58,7 @@ def integer_root_floor(n: int, t: int) -> int:
     return s
 
 
-def _power_candidates(spp: int, strengths, valid, block_dims) -> list[SppChoice]:
+def _power_candidates(spp: int, strengths, valid, choice) -> list[SppChoice]:
     """Counts ``s**t`` that can be among the two nearest to ``spp``: for each
     strength t, the two valid s at or below ``spp**(1/t)`` and the two above
     (``s**t <= MAX_SPP``). Searching outwards from the root instead of listing
@@ -69,7 +69,7 @@ def _power_candidates(spp: int, strengths, valid, block_dims) -> list[SppChoice]
         root = min(max(int(round(max(spp, 1) ** (1.0 / t))), 2), s_max)
         for side in (range(root, 1, -1), range(root + 1, s_max + 1)):
             found = list(itertools.islice((s for s in side if valid(s, t)), 2))
-            out += [SppChoice(s**t, s, t, block_dims(s, t)) for s in found]
+            out += [choice(s, t) for s in found]
     return out
 
 
@@ -80,6 +80,20 @@ class _OA(Construction):
     #: whether the 'j' offset's cell key is Bose's partner cell
     #: ``u * s + A_ij + 1`` rather than ``i + 1`` (docs/spec.md section 4)
     partner_cell_key = False
+    #: ``(s, t) -> Geometry(N, B, s, M)``: the reference module's ``*_geometry``
+    #: of the construction, the only definition of its shape (block size B
+    #: included) that every implementation and this catalogue read
+    geometry = None
+
+    def params_for(self, s: int, t: int) -> Params:
+        """The resolved parameters of the array with ``s`` symbols and strength ``t``."""
+        g = self.geometry(s, t)
+        return Params(s=s, strength=t, block_dims=g.B, M=g.M)
+
+    def choice_for(self, s: int, t: int) -> SppChoice:
+        """The sample count of the array with ``s`` symbols and strength ``t``, as a listed choice."""
+        g = self.geometry(s, t)
+        return SppChoice(g.N, s, t, g.B)
 
     def cells(self, i, col, params: Params):
         """``(A_ij, u)`` of samples ``i`` in columns ``col < block_dims``
@@ -104,6 +118,7 @@ class Bose(_OA):
     uses_field = True
     partner_cell_key = True
     reference = staticmethod(_reference_oa.bose)
+    geometry = staticmethod(_reference_oa.bose_geometry)
     numpy = staticmethod(_numpy_oa.bose)
     kernel = "bose_cell(row, col, s, gf, gf_tabled, &aij, &u); ck = u * s + aij + 1u"
     description = "Bose OA, strength 2: N = s^2 with s a prime power, s+1 dimensions per block"
@@ -124,7 +139,7 @@ class Bose(_OA):
     def choices(self, dims=None, strength=None):
         if strength not in (None, 2):
             return []
-        return [SppChoice(s * s, s, 2, s + 1) for s in range(2, self.max_s + 1) if gf.is_supported(s)]
+        return [self.choice_for(s, 2) for s in range(2, self.max_s + 1) if gf.is_supported(s)]
 
     def solve(self, spp, dims, strength):
         if strength not in (None, 2):
@@ -135,7 +150,7 @@ class Bose(_OA):
         s = math.isqrt(spp)
         if s * s != spp or not gf.is_supported(s) or s > self.max_s:
             return None
-        return Params(s=s, strength=2, block_dims=s + 1, M=s)
+        return self.params_for(s, 2)
 
     def invalid(self, spp, dims, strength):
         return f"{spp} is not s^2 with s a prime (<= {self.max_s}) or a prime power (<= {gf.MAX_TABLE_Q})"
@@ -149,6 +164,7 @@ class Bush(_OA):
     code = 2
     uses_field = True
     reference = staticmethod(_reference_oa.bush)
+    geometry = staticmethod(_reference_oa.bush_geometry)
     numpy = staticmethod(_numpy_oa.bush)
     kernel = "bush_cell(row, col, s, t, M, gf, gf_tabled, &aij, &u); ck = row + 1u"
     #: t <= s and s**t <= 2**24 allow t <= 8 (8**8 = 2**24; 9**9 is too large)
@@ -174,13 +190,13 @@ class Bush(_OA):
             s = max(2, t)
             while s**t <= MAX_SPP:
                 if gf.is_supported(s):
-                    out.append(SppChoice(s**t, s, t, s + 1))
+                    out.append(self.choice_for(s, t))
                 s += 1
         return sorted(out)
 
     def nearest(self, spp, dims=None, strength=None):
         return nearest(_power_candidates(spp, self._strengths(dims, strength),
-                                         lambda s, t: s >= t and gf.is_supported(s), lambda s, t: s + 1), spp)
+                                         lambda s, t: s >= t and gf.is_supported(s), self.choice_for), spp)
 
     def solve(self, spp, dims, strength):
         if strength is not None and not 2 <= strength <= self.max_strength:
@@ -192,7 +208,7 @@ class Bush(_OA):
         for t in sorted(self._strengths(dims, strength), reverse=True):
             s = integer_root(spp, t)
             if s is not None and s >= t and gf.is_supported(s):
-                return Params(s=s, strength=t, block_dims=s + 1, M=spp // s)
+                return self.params_for(s, t)
         return None
 
     def invalid(self, spp, dims, strength):
@@ -208,6 +224,7 @@ class CMJND(_OA):
     name = "cmjnd"
     code = 1
     reference = staticmethod(_reference_oa.cmjnd)
+    geometry = staticmethod(_reference_oa.cmjnd_geometry)
     numpy = staticmethod(_numpy_oa.cmjnd)
     kernel = "cmjnd_cell(row, s, pow_u(s, col), &aij, &u); ck = row + 1u"
     description = "N-dimensional correlated multi-jittered OA: N = s^t for any s >= 2, t dimensions per block"
@@ -233,17 +250,17 @@ class CMJND(_OA):
 
     def nearest(self, spp, dims=None, strength=None):
         return nearest(_power_candidates(spp, self._strengths(dims, strength),
-                                         lambda s, t: s >= 2, lambda s, t: t), spp)
+                                         lambda s, t: s >= 2, self.choice_for), spp)
 
     def choices(self, dims=None, strength=None):
         strengths = self._strengths(dims, strength)
         if strengths == [1]:  # every count 2 .. 2**24: listed lazily, not as 16.7 million tuples
-            return _Counts(2, MAX_SPP, lambda n: SppChoice(n, n, 1, 1))
+            return _Counts(2, MAX_SPP, lambda n: self.choice_for(n, 1))
         out = []
         for t in strengths:
             s = 2
             while s**t <= MAX_SPP:
-                out.append(SppChoice(s**t, s, t, t))
+                out.append(self.choice_for(s, t))
                 s += 1
         return sorted(out)
 
@@ -255,7 +272,7 @@ class CMJND(_OA):
         for t in sorted(self._strengths(dims, strength), reverse=True):
             s = integer_root(spp, t)
             if s is not None and s >= 2:
-                return Params(s=s, strength=t, block_dims=t, M=spp // s)
+                return self.params_for(s, t)
         return None
 
     def invalid(self, spp, dims, strength):
@@ -283,7 +300,7 @@ class _Index2(_OA):
     def choices(self, dims=None, strength=None):
         if strength not in (None, 2):
             return []
-        return [SppChoice(2 * s * s, s, 2, 2 * s + 1) for s in self.levels()]
+        return [self.choice_for(s, 2) for s in self.levels()]
 
     def solve(self, spp, dims, strength):
         if strength not in (None, 2):
@@ -291,7 +308,7 @@ class _Index2(_OA):
         s = math.isqrt(spp // 2)
         if spp % 2 or 2 * s * s != spp or s not in self.levels():
             return None
-        return Params(s=s, strength=2, block_dims=2 * s + 1, M=2 * s)
+        return self.params_for(s, 2)
 
 
 @register
@@ -302,6 +319,7 @@ class AddelmanKempthorne(_Index2):
     name = "addelman-kempthorne"
     code = 3
     reference = staticmethod(_reference_oa.addelman_kempthorne)
+    geometry = staticmethod(_reference_oa.addelman_kempthorne_geometry)
     numpy = staticmethod(_numpy_oa.addelman_kempthorne)
     cell = staticmethod(_numpy_oa.addelman_kempthorne_cell)
     kernel = "addelman_kempthorne_cell(row, col, s, gf, gf_tabled, consts, &aij, &u); ck = row + 1u"
@@ -336,6 +354,7 @@ class BoseBush(_Index2):
     name = "bose-bush"
     code = 4
     reference = staticmethod(_reference_oa.bose_bush)
+    geometry = staticmethod(_reference_oa.bose_bush_geometry)
     numpy = staticmethod(_numpy_oa.bose_bush)
     cell = staticmethod(_numpy_oa.bose_bush_cell)
     kernel = "bose_bush_cell(row, col, s, gf, gf_tabled, &aij, &u); ck = row + 1u"

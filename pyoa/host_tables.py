@@ -75,7 +75,9 @@ def block_seeds(req, pix0: int, pix1: int) -> tuple[np.ndarray, np.ndarray, np.n
     prm = req.params
     p = pixel_seed(req.seed, req.pixels[pix0:pix1])
     blocks, which = np.unique(req.dims // U32(prm.block_dims), return_inverse=True)
-    seeds = np.stack([block_seed(p, b) for b in blocks], axis=1).reshape(len(p), len(blocks))
+    seeds = np.empty((len(p), len(blocks)), dtype=U32)  # (pixels, distinct blocks); none for no dims
+    for k, b in enumerate(blocks):
+        seeds[:, k] = block_seed(p, b)
     orders = block_order_seed(seeds, blocks[None, :], prm.s * prm.M)
     return blocks, which.ravel(), seeds, orders
 

@@ -102,10 +102,12 @@ def test_dispatch_is_generated_from_the_catalogue():
     text = program.dispatch_source()
     for c in ENTRIES:
         if c.family == "oa":
-            assert f"case CONSTRUCTION_{c.function.upper()}: return {c.kernel};" in text
+            assert f"case CONSTRUCTION_{c.function.upper()}: {c.kernel}; break;" in text
         else:
             assert f"GENERATE_BASELINE({c.function}, {c.kernel})" in text
     assert "default: return NAN;" in text
+    # one block rule and one tail for every construction
+    assert text.count("oa_locate(") == 1 and text.count("return oa_tail(") == 1
     # generate.cl itself names no construction
     gen = (ROOT / "kernels" / "generate.cl").read_text()
     assert not re.search(r"CONSTRUCTION_[A-Z]", gen)
@@ -122,7 +124,7 @@ __kernel void t_dispatch(__global const uint *code, __global const ushort *gf, _
                          __global float *out)
 {
     uint g = get_global_id(0);
-    out[g] = oa_dispatch(code[g], 3u, 1u, 5u, 2u, 12345u, OFFSET_CMJ, 1.0f, gf, 0u, consts);
+    out[g] = oa_dispatch(code[g], 3u, 1u, 5u, 2u, 6u, 25u, 5u, 12345u, OFFSET_CMJ, 1.0f, gf, 0u, consts);
 }
 """)
     codes = np.array([catalogue.get("cmjnd").code, catalogue.get("bose").code, 999, 0xFFFFFFFF], np.uint32)

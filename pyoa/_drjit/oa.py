@@ -21,6 +21,7 @@ import drjit as dr
 import numpy as np
 
 from .. import gf
+from ..reference import oa as G  # the constructions' geometries (N, B, s, M)
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import centered_value, jitter_value, sample_value
 from .hashes import locate, permute, randfloat
@@ -103,12 +104,13 @@ def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
     return permute(u, M, seed)
 
 
-def oa_value(i, j, p, offset: str, jitter: float, *, N: int, B: int, s: int, M: int, cell):
+def oa_value(i, j, p, offset: str, jitter: float, geometry, cell):
     """:func:`pyoa.reference.oa.oa_value` over Dr.Jit arrays: the frame every
     construction shares. The block rule (:func:`.hashes.locate`) gives the
     copy's seed, the row and the column; ``cell(row, col)`` gives
     ``(A_ij, u, cell_key)``; then stratum, offset and the jitter of the row
     (docs/spec.md section 5.2)."""
+    N, B, s, M = geometry
     P, row, col = locate(p, i, j, B, N)
     aij, u, cell_key = cell(row, col)
     q = P * (col + 1)  # times the three keys: the column's seeds (section 3.3)
@@ -131,17 +133,17 @@ def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0):
         aij, aik = bose_cell(row, col, s)
         return aij, aik, aik * s + aij + 1  # the 'j' offset's key is the (A_ij, A_ik) cell
 
-    return oa_value(i, j, p, offset, jitter, N=s * s, B=s + 1, s=s, M=s, cell=cell)
+    return oa_value(i, j, p, offset, jitter, G.bose_geometry(s), cell)
 
 
 def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.cmjnd` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, N=s**t, B=t, s=s, M=s ** (t - 1), cell=_row_key(cmjnd_cell, s, t))
+    return oa_value(i, j, p, offset, jitter, G.cmjnd_geometry(s, t), _row_key(cmjnd_cell, s, t))
 
 
 def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.bush` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, N=s**t, B=s + 1, s=s, M=s ** (t - 1), cell=_row_key(bush_cell, s, t))
+    return oa_value(i, j, p, offset, jitter, G.bush_geometry(s, t), _row_key(bush_cell, s, t))
 
 
 def addelman_kempthorne_cell(i, col, q: int):
@@ -178,11 +180,9 @@ def bose_bush_cell(i, col, s: int):
 
 def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.addelman_kempthorne` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, N=2 * q * q, B=2 * q + 1, s=q, M=2 * q,
-                    cell=_row_key(addelman_kempthorne_cell, q))
+    return oa_value(i, j, p, offset, jitter, G.addelman_kempthorne_geometry(q), _row_key(addelman_kempthorne_cell, q))
 
 
 def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0):
     """:func:`pyoa.reference.bose_bush` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, N=2 * s * s, B=2 * s + 1, s=s, M=2 * s,
-                    cell=_row_key(bose_bush_cell, s))
+    return oa_value(i, j, p, offset, jitter, G.bose_bush_geometry(s), _row_key(bose_bush_cell, s))

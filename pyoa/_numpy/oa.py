@@ -15,6 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from .. import gf
+from ..reference import oa as G  # the constructions' geometries (N, B, s, M)
 from ..reference.hashes import BLOCK_ORDER_KEY, JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import F32, jitter_value, sample_value
 from .hashes import U32, block_seed, hash_pair, mix32, permute, randfloat
@@ -120,11 +121,12 @@ def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
     return permute(u, M, seed)
 
 
-def oa_value(i, j, p, offset: str, jitter: float, *, N: int, B: int, s: int, M: int, cell) -> np.ndarray:
+def oa_value(i, j, p, offset: str, jitter: float, geometry, cell) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.oa.oa_value`: the frame every
     construction shares. The block rule (:func:`locate`) gives the copy's seed,
     the row and the column; ``cell(row, col)`` gives ``(A_ij, u, cell_key)``;
     then stratum, offset and jitter (docs/spec.md section 5.2)."""
+    N, B, s, M = geometry
     P, row, col = locate(p, i, j, B, N)
     aij, u, cell_key = cell(row, col)
     q = P * (col + U32(1))  # times the three keys: the column's seeds (section 3.3)
@@ -139,7 +141,7 @@ def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarra
         aij, aik = bose_cell(row, col, s)
         return aij, aik, aik * U32(s) + aij + U32(1)
 
-    return oa_value(i, j, p, offset, jitter, N=s * s, B=s + 1, s=s, M=s, cell=cell)
+    return oa_value(i, j, p, offset, jitter, G.bose_geometry(s), cell)
 
 
 def _row_key(cell, *shape):
@@ -149,12 +151,12 @@ def _row_key(cell, *shape):
 
 def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.cmjnd` (parameters assumed valid)."""
-    return oa_value(i, j, p, offset, jitter, N=s**t, B=t, s=s, M=s ** (t - 1), cell=_row_key(cmjnd_cell, s))
+    return oa_value(i, j, p, offset, jitter, G.cmjnd_geometry(s, t), _row_key(cmjnd_cell, s))
 
 
 def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bush` (parameters assumed valid)."""
-    return oa_value(i, j, p, offset, jitter, N=s**t, B=s + 1, s=s, M=s ** (t - 1), cell=_row_key(bush_cell, s, t))
+    return oa_value(i, j, p, offset, jitter, G.bush_geometry(s, t), _row_key(bush_cell, s, t))
 
 
 @lru_cache(maxsize=None)
@@ -201,11 +203,9 @@ def bose_bush_cell(i, col, s: int):
 
 def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.addelman_kempthorne` (parameters assumed valid)."""
-    return oa_value(i, j, p, offset, jitter, N=2 * q * q, B=2 * q + 1, s=q, M=2 * q,
-                    cell=_row_key(addelman_kempthorne_cell, q))
+    return oa_value(i, j, p, offset, jitter, G.addelman_kempthorne_geometry(q), _row_key(addelman_kempthorne_cell, q))
 
 
 def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.bose_bush` (parameters assumed valid)."""
-    return oa_value(i, j, p, offset, jitter, N=2 * s * s, B=2 * s + 1, s=s, M=2 * s,
-                    cell=_row_key(bose_bush_cell, s))
+    return oa_value(i, j, p, offset, jitter, G.bose_bush_geometry(s), _row_key(bose_bush_cell, s))

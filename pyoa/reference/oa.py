@@ -29,6 +29,8 @@ References
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from .. import gf
 from .floats import f32, jitter_value, sample_value
 from .hashes import MASK, dimension_seeds, locate, permute, randfloat
@@ -68,10 +70,49 @@ def _offset_sub(offset: str, u: int, M: int, cell_key: int, aij: int, P2: int) -
     return permute(u, M, seed & MASK)
 
 
-def oa_value(i: int, j: int, p: int, offset: str, jitter: float, *, N: int, B: int, s: int, M: int, cell) -> float:
-    """``x(i, j)`` of an orthogonal array with ``N`` rows, ``B`` columns, ``s``
-    symbols and ``M = N / s`` sub-strata, seed ``p``: the frame every
-    construction shares.
+class Geometry(NamedTuple):
+    """The shape of one construction's array (docs/spec.md section 1.4): ``N``
+    rows, ``B`` columns per block, ``s`` symbols, ``M = N / s`` sub-strata.
+    Each construction's ``*_geometry`` function below is its only definition:
+    the NumPy and Dr.Jit implementations and the catalogue
+    (:mod:`pyoa.constructions`, whose ``Params`` carry ``block_dims = B`` and
+    ``M`` to the OpenCL kernels) read it from here."""
+
+    N: int
+    B: int
+    s: int
+    M: int
+
+
+def bose_geometry(s: int, t: int = 2) -> Geometry:
+    """Bose: ``N = s**2``, ``s + 1`` columns, ``M = s``."""
+    return Geometry(s * s, s + 1, s, s)
+
+
+def bush_geometry(s: int, t: int) -> Geometry:
+    """Bush: ``N = s**t``, ``s + 1`` columns, ``M = s**(t-1)``."""
+    return Geometry(s**t, s + 1, s, s ** (t - 1))
+
+
+def cmjnd_geometry(s: int, t: int) -> Geometry:
+    """CMJND: ``N = s**t``, ``t`` columns, ``M = s**(t-1)``."""
+    return Geometry(s**t, t, s, s ** (t - 1))
+
+
+def addelman_kempthorne_geometry(q: int, t: int = 2) -> Geometry:
+    """Addelman-Kempthorne: ``N = 2 q**2``, ``2q + 1`` columns, ``M = 2q``."""
+    return Geometry(2 * q * q, 2 * q + 1, q, 2 * q)
+
+
+def bose_bush_geometry(s: int, t: int = 2) -> Geometry:
+    """Bose-Bush: ``N = 2 s**2``, ``2s + 1`` columns, ``M = 2s``."""
+    return Geometry(2 * s * s, 2 * s + 1, s, 2 * s)
+
+
+def oa_value(i: int, j: int, p: int, offset: str, jitter: float, geometry: Geometry, cell) -> float:
+    """``x(i, j)`` of an orthogonal array of shape ``geometry`` (``N`` rows,
+    ``B`` columns per block, ``s`` symbols, ``M = N / s`` sub-strata), seed
+    ``p``: the frame every construction shares.
 
     The block rule (:func:`~.hashes.locate`, docs/spec.md section 6) gives
     the copy's seed ``P``, the row and the column; ``cell(row, col)`` (the
@@ -84,6 +125,7 @@ def oa_value(i: int, j: int, p: int, offset: str, jitter: float, *, N: int, B: i
 
     with ``(P1, P2, P3)`` the column's seeds (:func:`~.hashes.dimension_seeds`).
     """
+    N, B, s, M = geometry
     J = _check_common(i, N, j, p, offset, jitter)
     P, row, col = locate(p, i, j, B, N)
     aij, u, cell_key = cell(row, col)
@@ -124,7 +166,7 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
         aij, aik = bose_cell(row, col, s)
         return aij, aik, aik * s + aij + 1  # the 'j' offset's key is the (A_ij, A_ik) cell
 
-    return oa_value(i, j, p, offset, jitter, N=s * s, B=s + 1, s=s, M=s, cell=cell)
+    return oa_value(i, j, p, offset, jitter, bose_geometry(s), cell)
 
 
 def bose_cell(i: int, col: int, s: int) -> tuple[int, int]:
@@ -164,8 +206,7 @@ def cmjnd(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: f
     """
     if s < 2 or t < 1:
         raise ValueError(f"cmjnd needs s >= 2 and t >= 1, got s={s}, t={t}")
-    return oa_value(i, j, p, offset, jitter, N=s**t, B=t, s=s, M=s ** (t - 1),
-                    cell=lambda row, col: (*cmjnd_cell(row, col, s), row + 1))
+    return oa_value(i, j, p, offset, jitter, cmjnd_geometry(s, t), lambda row, col: (*cmjnd_cell(row, col, s), row + 1))
 
 
 def cmjnd_cell(i: int, col: int, s: int) -> tuple[int, int]:
@@ -214,8 +255,7 @@ def bush(i: int, j: int, s: int, t: int, p: int, offset: str = "cmj", jitter: fl
     """
     if not gf.is_supported(s) or not 2 <= t <= s:
         raise ValueError(f"bush needs s prime or a prime power <= {gf.MAX_TABLE_Q} and 2 <= t <= s, got s={s}, t={t}")
-    return oa_value(i, j, p, offset, jitter, N=s**t, B=s + 1, s=s, M=s ** (t - 1),
-                    cell=lambda row, col: (*bush_cell(row, col, s, t), row + 1))
+    return oa_value(i, j, p, offset, jitter, bush_geometry(s, t), lambda row, col: (*bush_cell(row, col, s, t), row + 1))
 
 
 def bush_cell(i: int, col: int, s: int, t: int) -> tuple[int, int]:
@@ -266,8 +306,8 @@ def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jit
     pr = gf.prime_power(q)
     if pr is None or pr[0] == 2 or not gf.is_supported(q):
         raise ValueError(f"addelman-kempthorne needs q an odd prime, or odd prime power <= {gf.MAX_TABLE_Q}, got {q}")
-    return oa_value(i, j, p, offset, jitter, N=2 * q * q, B=2 * q + 1, s=q, M=2 * q,
-                    cell=lambda row, col: (*addelman_kempthorne_cell(row, col, q), row + 1))
+    return oa_value(i, j, p, offset, jitter, addelman_kempthorne_geometry(q),
+                    lambda row, col: (*addelman_kempthorne_cell(row, col, q), row + 1))
 
 
 def addelman_kempthorne_cell(i: int, col: int, q: int) -> tuple[int, int]:
@@ -315,8 +355,7 @@ def bose_bush(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float
     """
     if s < 2 or s & (s - 1) or 2 * s > gf.MAX_TABLE_Q:
         raise ValueError(f"bose-bush needs s a power of two with 2 <= s <= {gf.MAX_TABLE_Q // 2}, got {s}")
-    return oa_value(i, j, p, offset, jitter, N=2 * s * s, B=2 * s + 1, s=s, M=2 * s,
-                    cell=lambda row, col: (*bose_bush_cell(row, col, s), row + 1))
+    return oa_value(i, j, p, offset, jitter, bose_bush_geometry(s), lambda row, col: (*bose_bush_cell(row, col, s), row + 1))
 
 
 def bose_bush_cell(i: int, col: int, s: int) -> tuple[int, int]:
