@@ -691,6 +691,14 @@ def part_figure(args, cpu: dict) -> None:
 # section
 
 
+def scene_means(errors: dict):
+    """``(scene, {label: mean, hw95, ratios...})`` of every scene the errors part measured, in SCENES order."""
+    for scene in SCENES:
+        sm = errors["summary"].get(scene)
+        if sm:
+            yield scene, sm["samplers"]
+
+
 def interpretation(speed: dict | None, errors: dict | None) -> str:
     out = []
     if speed:
@@ -711,11 +719,7 @@ def interpretation(speed: dict | None, errors: dict | None) -> str:
             f"{s['mitsuba independent|opaque']['median'] / s['mitsuba orthogonal|opaque']['median']:.2f}x.")
     if errors:
         parts = []
-        for scene in SCENES:
-            sm = errors["summary"].get(scene)
-            if not sm:
-                continue
-            v = sm["samplers"]
+        for scene, v in scene_means(errors):
             best = min((k for k in v if v[k]["spp"] <= 128), key=lambda k: v[k]["mean"])  # equal spp: not ldsampler 256
             parts.append(
                 f"on `{scene}` pyoa `bose` had {v['pyoa bose']['over_independent']:.2f}x the relMSE of Mitsuba's "
@@ -769,11 +773,7 @@ def block_order_effect(errors: dict, before: dict | None) -> str:
             "repeated the strata of the one before (`results/mitsuba/" + BEFORE + "`, the run before the "
             "fix, on " + cpu_text(before["machine"]["cpu"]) + "): " + "; ".join(parts) + ".")
     parts = []
-    for scene in SCENES:
-        sm = errors["summary"].get(scene)
-        if not sm:
-            continue
-        v = sm["samplers"]
+    for scene, v in scene_means(errors):
         bush, bose, orth = v["pyoa bush t=3"], v["pyoa bose"], v["mitsuba orthogonal"]
         parts.append(f"`{scene}`: `bush` t=3 / `bose` {bush['mean'] / bose['mean']:.2f} "
                      f"({_verdict(bush, bose)}), / `orthogonal` {bush['over_orthogonal']:.2f} "

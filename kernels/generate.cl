@@ -152,18 +152,33 @@ __kernel void tables_finish(__global uint *restrict tab,
     tab[g] = (x >= l) ? x - l : x;
 }
 
-/* generate_cells: axis 0 is the sample position k in [0, n_k). The cells
- * (A_ij and the sub-stratum index u of every requested dimension and sample)
- * do not depend on the pixel; the host computes them once per launch
- * (pyoa._numpy.oa.cells), laid out [d][k], so that every construction shares
- * these straight-line kernels and its loads along k are contiguous. */
-#define GENERATE_CELLS(NAME, VALUE)                                                     \
+/* The values of the table path: axis 0 is the sample position k in [0, n_k),
+ * axis 1 pd. Each value gathers its stratum (and 'cmj' sub-stratum) from its
+ * (pixel, dimension)'s table at its cell, A_ij and u, from cell_a and
+ * cell_u; LOCATE sets the cell's index c in them and the row the jitter
+ * hashes (section 6), from the kernel's own arguments (__VA_ARGS__, between
+ * the cells and n_k). Two instances:
+ *
+ * - generate_cells (every dimension in block 0): the cells do not depend on
+ *   the pixel; the host computes them once per launch (pyoa.host_tables.cells),
+ *   laid out [d][k], so that every construction shares these straight-line
+ *   kernels and their loads along k are contiguous; isamp holds the sample
+ *   indices (the rows of block 0).
+ * - generate_rows (some dimension past block 0): a later block reads its copy
+ *   at its own rows, so its cells depend on the pixel. `rows` holds the row
+ *   of every sample position per slot: slot 0 (offset 0) the sample indices
+ *   themselves (block 0, shared by every pixel), then one slot per (pixel,
+ *   block >= 1) filled by block_rows; ro[pd] is the offset of (pixel,
+ *   dimension) pd's slot. cell_a and cell_u hold the cells of every row of
+ *   the array in each requested dimension's column ([d][row],
+ *   pyoa.host_tables.array_cells), so one gather serves both. */
+#define GENERATE_TABLED(NAME, LOCATE, VALUE, ...)                                       \
 __kernel void NAME(__global float *restrict out,                                        \
                    const uint out0,                                                     \
                    __global const uint *restrict tab,                                   \
                    __global const uint *restrict cell_a,                                \
                    __global const uint *restrict cell_u,                                \
-                   __global const uint *restrict isamp,                                 \
+                   __VA_ARGS__,                                                         \
                    const uint n_k,                                                      \
                    const uint n_dims,                                                   \
                    const uint E,                                                        \
@@ -174,54 +189,27 @@ __kernel void NAME(__global float *restrict out,                                
 {                                                                                       \
     uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                      \
     uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;                             \
-    uint c = d * n_k + k;                                                               \
-    uint stratum = tab[base + cell_a[c]];                                               \
-    float jit = jitter_value(randfloat(isamp[k], tab[base + E - 1u]), J);               \
-    out[rect_index(out0, k, pl, d, n_k, n_dims)] = VALUE;                               \
-}
-
-/* One kernel per offset of the table path rather than one with an offset
- * argument: a select between the two value paths, even on that uniform
- * argument, kept PoCL from vectorizing (0.20 instead of 0.55 G values/s,
- * docs/performance.md). 'centered' passes cell_u = 0 and never reads it. */
-GENERATE_CELLS(generate_cells, sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s))
-GENERATE_CELLS(generate_cells_centered, centered_value(stratum, jit, M, s))
-
-/* The table path of requests with dimensions past block 0 (docs/spec.md
- * section 6): a later block reads its copy at its own rows, so its cells
- * depend on the pixel. `rows` holds the row of every sample position per
- * slot: slot 0 (offset 0) the sample indices themselves (block 0, shared by
- * every pixel), then one slot per (pixel, block >= 1) filled by block_rows;
- * ro[pd] is the offset of (pixel, dimension) pd's slot. cell_a and cell_u
- * hold the cells of every row of the array in each requested dimension's
- * column ([d][row], pyoa.host_tables.array_cells), so one gather serves both. */
-#define GENERATE_ROWS(NAME, VALUE)                                                      \
-__kernel void NAME(__global float *restrict out,                                        \
-                   const uint out0,                                                     \
-                   __global const uint *restrict tab,                                   \
-                   __global const uint *restrict cell_a,                                \
-                   __global const uint *restrict cell_u,                                \
-                   __global const uint *restrict rows,                                  \
-                   __global const uint *restrict ro,                                    \
-                   const uint n_k,                                                      \
-                   const uint n_dims,                                                   \
-                   const uint E,                                                        \
-                   const uint Es,                                                       \
-                   const uint s,                                                        \
-                   const uint M,                                                        \
-                   const uint N,                                                        \
-                   const float J)                                                       \
-{                                                                                       \
-    uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                      \
-    uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;                             \
-    uint row = rows[ro[pd] + k], c = d * N + row;                                       \
+    LOCATE                                                                              \
     uint stratum = tab[base + cell_a[c]];                                               \
     float jit = jitter_value(randfloat(row, tab[base + E - 1u]), J);                    \
     out[rect_index(out0, k, pl, d, n_k, n_dims)] = VALUE;                               \
 }
 
-GENERATE_ROWS(generate_rows, sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s))
-GENERATE_ROWS(generate_rows_centered, centered_value(stratum, jit, M, s))
+#define CELLS_BY_SAMPLE uint c = d * n_k + k, row = isamp[k];
+#define CELLS_BY_ROW uint row = rows[ro[pd] + k], c = d * N + row;
+#define CMJ_VALUE sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s)
+#define CENTERED_VALUE centered_value(stratum, jit, M, s)
+
+/* One kernel per offset of the table path rather than one with an offset
+ * argument: a select between the two value paths, even on that uniform
+ * argument, kept PoCL from vectorizing (0.20 instead of 0.55 G values/s,
+ * docs/performance.md). 'centered' passes cell_u = 0 and never reads it. */
+GENERATE_TABLED(generate_cells, CELLS_BY_SAMPLE, CMJ_VALUE, __global const uint *restrict isamp)
+GENERATE_TABLED(generate_cells_centered, CELLS_BY_SAMPLE, CENTERED_VALUE, __global const uint *restrict isamp)
+GENERATE_TABLED(generate_rows, CELLS_BY_ROW, CMJ_VALUE,
+                __global const uint *restrict rows, __global const uint *restrict ro, const uint N)
+GENERATE_TABLED(generate_rows_centered, CELLS_BY_ROW, CENTERED_VALUE,
+                __global const uint *restrict rows, __global const uint *restrict ro, const uint N)
 
 /* The rows of the later blocks' slots: axis 0 the sample position k, axis 1
  * the slot m - 1 (slot m = 1 + pixel * blocks + block index), whose order

@@ -73,8 +73,20 @@ def locate(p, i, j, B: int, N: int):
 
 def block_row(i, N: int, r):
     """``permute(permute(i, N, r), N, mix32(r))`` (:func:`pyoa.reference.hashes.block_row`):
-    the row of sample ``i`` in a block whose order seed is ``r``; ``i`` where ``r == 0``."""
-    return permute(permute(i, N, r), N, mix32(r))
+    the row of sample ``i`` in a block whose order seed is ``r``; ``i`` where ``r == 0``.
+
+    The two permutations run inside a loop of at most one iteration whose
+    lanes are active only where ``r != 0``: inside Mitsuba the dimension is
+    an opaque value, the same in every lane of a draw, so in block 0 (most
+    draws of a short path) Dr.Jit's loop finds no active lane and skips both
+    permutations instead of computing and discarding them."""
+    U = type(i) if dr.is_array_v(i) else type(r)
+    i, r = U(i), U(r)
+    if N == 1:
+        return U(0)
+    return dr.while_loop(state=(i, r, r != 0), cond=lambda x, r, todo: todo,
+                         body=lambda x, r, todo: (permute(permute(x, N, r), N, mix32(r)), r, todo & False),
+                         label="pyoa_block_row")[0]
 
 
 def derived_seed(p, index, key: int):

@@ -323,9 +323,9 @@ class OpenCLBackend:
         self._launch_2d(
             "generate_rows_centered" if centered else "generate_rows", n_k, n_pd,
             buf, np.uint32(at), tab, aij, u, rows,
-            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(offsets, dtype=np.uint32)),
+            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(offsets, dtype=np.uint32)), np.uint32(prm.s * prm.M),
             np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M),
-            np.uint32(prm.s * prm.M), np.float32(req.jitter),
+            np.float32(req.jitter),
         )
 
     def _array_cells(self, req: Request) -> tuple:
