@@ -102,8 +102,10 @@ def verdicts(table: dict) -> list[str]:
                         "pair it stratifies is coarser and most pairs of a path fall across blocks, where "
                         "both samplers pair at random (docs/spec.md section 6). These scenes' error comes "
                         "mostly from pairs of dimensions (pixel and lens, light position), which `bose` "
-                        "stratifies on a finer grid; a triple only pays where three dimensions of one block "
-                        "interact, as in the Mitsuba study's glossy scene below."]
+                        "stratifies on a finer grid. A triple pays only where three dimensions of one block "
+                        "interact more than pairs do (the `triples0` integrand of the faure section below); "
+                        "no render of this study is such a case at these counts, nor is any scene of the "
+                        "Mitsuba study below (its glossy scene included)."]
     return lines
 
 

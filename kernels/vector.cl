@@ -175,7 +175,7 @@ static inline __attribute__((always_inline)) float8 value_v8(
     uint8 row = i;
 #if VLATER
     uint order = w[5];
-    if (order != 0u) {  /* a later block: its own rows (dimensions of one block share them) */
+    if ((VLATER_MASK >> d) & 1ul) {  /* a later block (known when the program is built): its own rows */
         if (order != *last_order) {
             *later_row = block_row_v8(i, order);
             *last_order = order;
@@ -195,7 +195,7 @@ static inline __attribute__((always_inline)) float8 value_v8(
 #else
     uint8 u = vload8(b, cell_u + d * VNKP);
 #if VLATER
-    if (order != 0u) u = gather_v8(array_u + d * VN, row);
+    if ((VLATER_MASK >> d) & 1ul) u = gather_v8(array_u + d * VN, row);
 #endif
 #if VSUB == 1
     uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);

@@ -101,7 +101,12 @@ class Shape(_Rows):
     s_packed: bool
     sub: int  # 0 none, 1 tabled as fields, 2 walked per value
     jkey_bose: bool
-    later: bool = False  # some dimension lies past block 0 (docs/spec.md section 6)
+    #: bit d set: requested dimension d lies past block 0 (docs/spec.md section 6), so it reads its own rows
+    later_mask: int = 0
+
+    @property
+    def later(self) -> bool:
+        return self.later_mask != 0
 
     @property
     def tabled(self) -> bool:
@@ -122,6 +127,7 @@ class Shape(_Rows):
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
             "VN": f"{self.s * self.M}u", "VWN": f"{walk_mask(self.s * self.M)}u", "VLATER": int(self.later),
+            "VLATER_MASK": f"{self.later_mask:#x}ul",
             "VGROUPED": int(self.n_dims > MAX_WHOLE_ROWS),
         })
 
@@ -183,7 +189,8 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     else:
         return None
     return Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
-                 req.construction.partner_cell_key, req.past_block0)
+                 req.construction.partner_cell_key,
+                 sum(1 << d for d, j in enumerate(req.dims.tolist()) if j >= prm.block_dims))
 
 
 def store_code(n_dims: int, tail: int) -> tuple[str, str]:
