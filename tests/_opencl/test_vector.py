@@ -49,8 +49,8 @@ CASES = {
     # more than 16 dimensions: groups of 8 (kernels/vector.cl, VGROUPED), here 4 of 8 and a
     # tail group of 5 over blocks 0-3 of 12, in an order that returns to block 0
     "bose-s11-grouped": ({"name": "bose", "spp": 121, "dims": 48}, [*range(20, 48), 0, 1, 2, 13, 5, 3, 30, 31, 47]),
-    # a whole grouped request (46 dimensions, like the 'deep' scene) of a walked sub-stratum
-    "bush-s5-t3-46": ({"name": "bush", "spp": 125, "strength": 3, "dims": 46}, None),
+    # a whole grouped request of a walked sub-stratum: groups of 8, 8 and a tail of 7, blocks 0-3 of 6
+    "bush-s5-t3-23": ({"name": "bush", "spp": 125, "strength": 3, "dims": 23}, None),
 }
 CASE_PIXELS = [0, 7, U32_MAX]
 
