@@ -809,7 +809,10 @@ def part_section(args) -> None:
     fig = ("![Mitsuba's and pyoa's samplers](results/mitsuba/samplers.png)\n\n"
            "Seed 0 of each sampler on `cornell-dof`, relMSE in the titles.\n"
            if (OUT / "samplers.png").exists() else "")
-    footer = ("Regenerate with `python benchmarks/mitsuba_study.py` (about 13 minutes on 2 cores; `--parts "
+    spent = sum(json.loads((OUT / f"{p}.json").read_text()).get("wall_s", 0) for p in ("speed", "errors", "integrand")
+                if (OUT / f"{p}.json").exists())
+    footer = (f"Regenerate with `python benchmarks/mitsuba_study.py` (its parts took {spent / 60:.0f} minutes "
+              "here on 2 cores; `--parts "
               "section` rewrites this section from the saved files in `docs/results/mitsuba/`).")
     body = "\n".join([BEGIN, "## pyoa inside Mitsuba 3", "", intro, "", interpretation(speed, errors), "",
                       *parts, fig, footer, END, ""])
