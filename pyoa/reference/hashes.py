@@ -178,7 +178,8 @@ def block_row(i: int, N: int, r: int) -> int:
     ``N`` Kensler's permute is a single round of its hash and its family of
     permutations is small; one of them left some pairs of columns across
     blocks filling 8 % fewer coarse cells than a random pairing (Bose 16,
-    columns 1 and 1: 10.8 of 11.6), two bring every pair tried within 1 %.
+    columns 1 and 1: 10.8 of 11.6), two bring every pair tried within 1.3 %
+    (docs/spec.md section 6).
     """
     return permute(permute(i, N, r), N, mix32(r))
 
