@@ -33,15 +33,7 @@ def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     cell function (:meth:`pyoa.constructions._OA.cells`). ``u`` is 0 for the
     ``centered`` offset, which has no sub-stratum.
     """
-    prm = req.params
-    i = req.samples[k0:k1][None, :]
-    col = (req.dims % U32(prm.block_dims))[:, None]
-    aij, u = req.construction.cells(i, col, prm)
-    shape = (req.n_dims, k1 - k0)
-    aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
-    if req.offset == "centered":
-        return aij, np.zeros(shape, U32)
-    return aij, np.ascontiguousarray(np.broadcast_to(u, shape), dtype=U32)
+    return _cells_at(req, req.samples[k0:k1])
 
 
 def array_cells(req) -> tuple[np.ndarray, np.ndarray]:
@@ -50,11 +42,15 @@ def array_cells(req) -> tuple[np.ndarray, np.ndarray]:
     ``(n_dims, N)``, laid out ``[d][row]``. The table paths gather from them
     at a later block's own rows (docs/spec.md section 6). ``u`` is 0 for the
     ``centered`` offset."""
-    prm = req.params
-    rows = np.arange(prm.s * prm.M, dtype=U32)[None, :]
-    col = (req.dims % U32(prm.block_dims))[:, None]
-    aij, u = req.construction.cells(rows, col, prm)
-    shape = (req.n_dims, prm.s * prm.M)
+    return _cells_at(req, np.arange(req.params.s * req.params.M, dtype=U32))
+
+
+def _cells_at(req, rows) -> tuple[np.ndarray, np.ndarray]:
+    """``(A_ij, u)`` of ``rows`` in each requested dimension's column, shape
+    ``(n_dims, len(rows))``, C-contiguous uint32; ``u`` is 0 for ``centered``."""
+    col = (req.dims % U32(req.params.block_dims))[:, None]
+    aij, u = req.construction.cells(np.asarray(rows, dtype=U32)[None, :], col, req.params)
+    shape = (req.n_dims, len(rows))
     aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
     if req.offset == "centered":
         return aij, np.zeros(shape, U32)

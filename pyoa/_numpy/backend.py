@@ -66,8 +66,11 @@ class NumpyBackend:
         q = seeds[:, which] * (col + U32(1))  # (pixels, dims): the column keys
         i = req.samples[rect.k0 : rect.k1]
         n_p, n_k = rect.n_pixels, rect.n_k
-        rows = np.broadcast_to(i[None, :, None], (n_p, n_k, req.n_dims)).copy()
-        aij, u = (np.broadcast_to(c.T[None], rows.shape).copy() for c in host_tables.cells(req, rect.k0, rect.k1))
+        rows = i[None, :, None]  # block 0: the samples themselves, for every pixel
+        aij, u = (c.T[None] for c in host_tables.cells(req, rect.k0, rect.k1))
+        if blocks.size and blocks[-1] != 0:  # a later block: its rows and cells depend on the pixel
+            rows = np.broadcast_to(rows, (n_p, n_k, req.n_dims)).copy()
+            aij, u = (np.broadcast_to(c, rows.shape).copy() for c in (aij, u))
         for b, block in enumerate(blocks):
             if block == 0:
                 continue

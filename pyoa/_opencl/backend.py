@@ -74,6 +74,8 @@ class OpenCLBackend:
         self._fields: dict[int, tuple] = {}
         self._consts: dict[tuple, object] = {}
         self._scratch_bufs: dict[str, object] = {}
+        #: the last request shape's array cells (_array_cells) and its key
+        self._cells_key, self._cells_bufs = None, ()
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
         #: A CPU device (PoCL) writes straight into the caller's array
@@ -337,7 +339,7 @@ class OpenCLBackend:
         from ..host_tables import array_cells
 
         key = (req.construction.name, req.params, req.offset, req.dims.tobytes())
-        if getattr(self, "_cells_key", None) != key:
+        if self._cells_key != key:
             ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
             self._cells_bufs = tuple(cl.Buffer(self.context, ro, hostbuf=a) for a in array_cells(req))
             self._cells_key = key
