@@ -252,7 +252,7 @@ def pairwise(d: int, sigma: float = 0.15) -> Integrand:
 
 
 def lagged_pairs(d: int, lag: int | None = None, sigma: float = 0.15) -> Integrand:
-    """Mean of products of dimensions ``lag`` apart,
+    r"""Mean of products of dimensions ``lag`` apart,
     :math:`f(x) = \frac{1}{d - L} \sum_{k=0}^{d-L-1} g(x_k)\,g(x_{k+L})` (``g``
     as in :func:`pairwise`, ``L = lag``, default ``d // 2``).
 

@@ -75,12 +75,14 @@ def test_table_path_splits_long_axes_and_partial_pixels(monkeypatch, opencl, off
     than one work-group with full groups plus a remainder launch at a global
     offset (Bose s=37: 1369 samples = 21 x 64 + 25). With a chunk of 1.5 pixels
     every chunk is a head, whole-pixel and tail rectangle, each on the table path.
-    Same bits as NumPy, and as the reference at the seams."""
+    Same bits as NumPy, and as the reference at the seams. The table path is
+    forced: ``auto`` takes the direct path on a GPU."""
     from pyoa.request import Rect
 
     n = 1369
     kw = dict(spp=n, dims=7, seed=5, offset=offset)
     smp = pyoa.sampler("bose", backend="opencl", **kw)
+    monkeypatch.setattr(smp._backend, "path", "tables")
     assert n > smp._backend._axis_limit and n % 64  # both launches of _launch_2d
     pixels = [3, 2**32 - 1, 0, 17]
     want = pyoa.sampler("bose", backend="numpy", **kw).generate(pixels=pixels)

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The GPU check of a session that is lent an NVIDIA machine (see
+# benchmarks/README.md, "On a GPU"): pyoa's conformance, block-rule, request,
+# sampler and render suites with the OpenCL device set to the NVIDIA GPU, then
+# the generate benchmark's Bose cases there. The wheels pyoa needs beyond that
+# machine's image are carried in .whl/ (pyopencl and its helpers, embreex,
+# OpenImageIO, trimesh, dask/distributed); logs go to $OUT.
+set -u
+OUT=${OUT:-/tmp/out}
+mkdir -p "$OUT"
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
+    --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=/tmp/site:$PWD PYTHONUNBUFFERED=1
+# The source tree maps kernels/ and scenes/ into the package only when
+# installed (setup.cfg package_dir); this copy is run from the tree.
+ln -sfn ../kernels pyoa/kernels && ln -sfn ../scenes pyoa/scenes
+# pip's pyopencl carries its own ICD loader; point it at NVIDIA's driver (the
+# image's own vendors folder may list only PoCL).
+lib=$(find /usr/local/nvidia /usr/lib /usr/lib64 -name 'libnvidia-opencl.so*' 2>/dev/null | head -1)
+echo "NVIDIA OpenCL library: ${lib:-none found}"; [ -n "$lib" ] || exit 1
+if [ -n "$lib" ]; then
+    mkdir -p /tmp/vendors && echo "$lib" > /tmp/vendors/nvidia.icd
+    export OCL_ICD_VENDORS=/tmp/vendors
+fi
+nvidia-smi -L
+python3 -c 'import numpy, numba, pyopencl as cl; print("numpy", numpy.__version__, "numba", numba.__version__);
+[print(p.name, p.version, "|", d.name, d.driver_version) for p in cl.get_platforms() for d in p.get_devices()]' || exit 1
+export PYOA_OPENCL_DEVICE=nvidia PYOA_REQUIRE_OPENCL=1 PYOA_TEST_DEVICES=all
+python3 -m pyoa backends 2>&1 | tee "$OUT/backends.txt"
+TESTS=${TESTS:-"tests/_opencl tests/test_conformance.py tests/test_baselines_conformance.py
+    tests/test_block_pairs.py tests/test_spec_blocks.py tests/test_catalogue.py tests/test_request.py
+    tests/test_samplers.py tests/test_faure.py tests/test_to_dask.py tests/render"}
+# shellcheck disable=SC2086
+timeout "${TEST_LIMIT:-330}" python3 -m pytest -q -n 14 -p no:cacheprovider $TESTS 2>&1 \
+    | tee "$OUT/conformance-gpu.log" | tail -40
+echo "pytest exit: ${PIPESTATUS[0]}"
+[ "${BENCH_LIMIT:-90}" = 0 ] || timeout "${BENCH_LIMIT:-90}" python3 benchmarks/bench_generate.py --backends opencl --no-peers \
+    --cases bose-cmj-121x10,bose-cmj-121x12,bose-cmj-121x36,bush-cmj-125x10 --repeats 9 \
+    --out "$OUT/generate-gpu.json" 2>&1 | tail -20
+ls -la "$OUT"
