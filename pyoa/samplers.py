@@ -20,6 +20,7 @@ import os
 import re
 from collections.abc import Mapping, Sequence, Set
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 
@@ -54,11 +55,39 @@ def samplers() -> dict[str, str]:
     return {name: c.description for name, c in catalogue.SAMPLERS.items()}
 
 
+#: cgroup files that hold a container's memory limit (v2, then v1); "max" or
+#: a huge number means none.
+_CGROUP_LIMITS = ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes")
+
+
 def _physical_memory() -> int:
+    """The memory this process may use: the physical memory, or less where a
+    container's cgroup limit or an address-space limit (``ulimit -v``,
+    ``RLIMIT_AS``: what is left of it beyond the current ``VmSize``) says so.
+    A default sized from the physical memory alone let a request pass the
+    size check and then fail with ``MemoryError`` under such a limit."""
     try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        found = [os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")]
     except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-        return 8 << 30
+        found = [8 << 30]
+    for path in _CGROUP_LIMITS:
+        try:
+            text = Path(path).read_text().strip()
+        except OSError:
+            continue
+        if text.isdigit() and int(text) < 1 << 60:
+            found.append(int(text))
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft != resource.RLIM_INFINITY:
+            with open("/proc/self/status") as status:
+                vm = next((int(line.split()[1]) * 1024 for line in status if line.startswith("VmSize:")), 0)
+            found.append(max(soft - vm, 1 << 20))
+    except (ImportError, OSError, ValueError):  # pragma: no cover - non-Linux
+        pass
+    return min(found)
 
 
 #: What :func:`parse_bytes` accepts, for its error messages.
@@ -147,7 +176,9 @@ def parse_bytes(value, name: str = "max_bytes") -> int:
 
 
 def default_max_bytes() -> int:
-    """``$PYOA_MAX_BYTES`` if set (see :func:`parse_bytes`), else half of the physical memory."""
+    """``$PYOA_MAX_BYTES`` if set (see :func:`parse_bytes`), else half of the
+    memory this process may use (the physical memory, or a cgroup or
+    ``RLIMIT_AS`` limit below it)."""
     env = os.environ.get(ENV_MAX_BYTES)
     return parse_bytes(env, f"${ENV_MAX_BYTES}") if env else _physical_memory() // 2
 

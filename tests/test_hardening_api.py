@@ -165,6 +165,24 @@ def run_limited(code: str, extra_gib: float = 1.5) -> subprocess.CompletedProces
                           text=True, timeout=120, env={**__import__("os").environ, "PYOA_BACKEND": "numpy"})
 
 
+def test_default_limit_follows_an_address_space_limit():
+    """The default memory limit is half of what the process may use: under
+    ``ulimit -v`` (here: 1.5 GiB beyond the current size) a 3 GiB request is
+    refused with the size, not attempted (it used to be sized from the
+    physical memory alone and fail with MemoryError)."""
+    code = """
+        s = pyoa.sampler("bose", spp=121, dims=8, backend="numpy")
+        try:
+            s.generate(pixels=range(832_000))
+        except Exception as exc:
+            print(type(exc).__name__, exc)
+    """
+    res = run_limited(code)
+    assert res.returncode == 0, res.stderr
+    line = res.stdout.strip()
+    assert line.startswith("ValueError") and "memory limit" in line and "3.0 GiB" in line, line
+
+
 def test_huge_pixel_ranges_are_refused_before_allocating():
     code = """
         import time
