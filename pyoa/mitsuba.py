@@ -32,7 +32,8 @@ sample_count : int
     Samples per pixel, N (default 4). It must be a valid count of the
     sampler (``pyoa spp SAMPLER``); an invalid one fails when the scene loads
     with pyoa's own message naming the nearest valid counts. ``mi.render(...,
-    spp=N)`` changes it the same way.
+    spp=N)`` changes it the same way; a refused N leaves the sampler as it
+    was (every check runs before any state changes).
 seed : int
     Added by Mitsuba to the seed of each render (``mi.render(seed=...)``);
     the sum modulo ``2**32`` is pyoa's seed.
@@ -45,10 +46,14 @@ offset, jitter, strength, base, dims : str, float, int, int, int
 samples_per_pass : int
     Only for an integrator that renders in passes (its own
     ``samples_per_pass``): the same value, a divisor of ``sample_count``.
-    Mitsuba tells a sampler its samples per pass through a C++ method that
-    a Python plugin cannot see, so the plugin must be told; without it a
-    render in passes fails at its second pass (``advance()``) with a message
-    saying this, never with a wrong image. Default: one pass.
+    Default: one pass. Mitsuba tells a sampler its samples per pass through
+    a non-virtual C++ method that a Python plugin never sees, so the plugin
+    is told, and it reads the count Mitsuba set at every ``seed()``: a render
+    whose samples per pass differ from the sampler's (the integrator's
+    ``samples_per_pass`` without the same value here, a different value, or
+    Mitsuba's own split of a pass over 2^32 samples) is refused there with
+    a ValueError saying this, before any value is drawn, never rendered with
+    a wrong mapping.
 
 The mapping
 -----------
@@ -72,6 +77,8 @@ speed. JIT variants (``llvm_*``, ``cuda_*``) only: loading the sampler in a
 """
 
 from __future__ import annotations
+
+import ctypes
 
 from .drjit_llvm import configure as _configure_llvm
 
@@ -123,6 +130,42 @@ def _resolve(opts: dict, spp: int):
                          backend="numpy")  # never used to generate: no OpenCL set-up
 
 
+#: How many 32-bit words at the start of a sampler's C++ object :func:`_find_samples_per_wavefront`
+#: reads: Mitsuba 3.9's ``Sampler`` members lie within the first 18 (``m_samples_per_wavefront`` is
+#: word 14 on x86-64 Linux), and a Python sampler's C++ object is 240 bytes (nanobind's trampoline
+#: table follows the members; Mitsuba 3.9.1, llvm_ad_rgb), so every word read belongs to the object.
+_PROBE_WORDS = 32
+
+
+def _find_samples_per_wavefront(smp, base: type) -> int:
+    """The byte offset of Mitsuba's ``Sampler::m_samples_per_wavefront`` in ``smp``'s C++ object.
+
+    Mitsuba's render loop tells the sampler its samples per pixel per pass with
+    ``Sampler::set_samples_per_wavefront``, a non-virtual C++ method: it never reaches a sampler
+    written in Python, and the value it stores has no getter. The plugin reads it at every
+    ``seed()`` (the only way to know how Mitsuba splits the wavefront into pixels), at the offset
+    found here, once per class: the method, called through ``base`` (``mi.Sampler``) with three
+    values, must change exactly one 32-bit word of the object to those values. ``smp`` must be
+    freshly constructed (Mitsuba's default base sample_count, 4, which the values divide).
+
+    Raises
+    ------
+    RuntimeError
+        When no single word follows the values (a Mitsuba build with another layout).
+    """
+    words = (ctypes.c_uint32 * _PROBE_WORDS).from_address(smp.ptr)
+    probes = (4, 2, 1)
+    seen = []
+    for value in probes:
+        base.set_samples_per_wavefront(smp, value)
+        seen.append(list(words))
+    hits = [k for k in range(_PROBE_WORDS) if tuple(w[k] for w in seen) == probes]
+    if len(hits) != 1:
+        raise RuntimeError(f"pyoa.mitsuba: cannot find a sampler's samples per pass in this Mitsuba build "
+                           f"({mi.__version__}; found {len(hits)} candidates): pyoa.mitsuba supports Mitsuba 3.9.x")
+    return 4 * hits[0]
+
+
 def _make_class(base: type) -> type:
     """The plugin's class on ``base``, one Mitsuba variant's ``mi.Sampler``."""
 
@@ -140,22 +183,31 @@ def _make_class(base: type) -> type:
             self._base_seed = self._opts.get("seed", 0)
             if not 0 <= self._base_seed <= MAX_UINT32:
                 raise ValueError(f"pyoa sampler: seed must be a uint32 in [0, {MAX_UINT32}], got {self._base_seed}")
+            if PyoaSampler._spw_offset is None:  # once per class, on a fresh object (see the function)
+                PyoaSampler._spw_offset = _find_samples_per_wavefront(self, base)
             self._configure(self._opts.get("sample_count", 4))
             self._unseed()
+
+        #: byte offset of Mitsuba's m_samples_per_wavefront in the C++ object (_find_samples_per_wavefront)
+        _spw_offset = None
 
         # -- parameters -------------------------------------------------------------------------------
 
         def _configure(self, spp: int) -> None:
-            self._pyoa = _resolve(self._opts, spp)
+            """Make ``spp`` the sample count: every check runs before any state changes, so a refused
+            count (``mi.render(scene, spp=N)``) leaves the sampler exactly as it was."""
+            pyoa_sampler = _resolve(self._opts, spp)
             per_pass = self._opts.get("samples_per_pass", 0) or spp
             if per_pass < 1 or spp % per_pass:
-                raise ValueError(f"pyoa sampler: samples_per_pass ({per_pass}) must divide sample_count ({spp})")
-            self._spp = spp
-            # Mitsuba's own render loop sets the samples per wavefront through a non-virtual C++ method
-            # that never reaches this class: it is sample_count, or samples_per_pass when given here
-            # (the integrator's samples_per_pass, which must then be the same)
+                raise ValueError(f"pyoa sampler: samples_per_pass ({per_pass}) must divide sample_count ({spp}); "
+                                 "give a sample count (mi.render(spp=...)) that is a multiple of samples_per_pass")
+            self._pyoa, self._spp = pyoa_sampler, spp
+            # the samples per pass this sampler maps lanes with: sample_count, or samples_per_pass when
+            # given here (the integrator's, which must then be the same); seed() checks it against the
+            # count Mitsuba's render loop set in the C++ base, which starts out equal to it
             self._spw = per_pass
             super().set_sample_count(spp)
+            super().set_samples_per_wavefront(per_pass)
 
         def set_sample_count(self, spp: int) -> None:
             self._configure(int(spp))
@@ -164,11 +216,17 @@ def _make_class(base: type) -> type:
             return self._spp
 
         def set_samples_per_wavefront(self, samples_per_wavefront: int) -> None:
-            n = int(samples_per_wavefront)  # reached from Python only (see _configure)
+            # reached from Python only (Mitsuba's Python integrators, tests): the C++ render loop calls
+            # the base method directly, which seed() reads back (_mitsuba_samples_per_wavefront)
+            n = int(samples_per_wavefront)
             if n < 1 or self._spp % n:
                 raise ValueError(f"pyoa sampler: samples per wavefront ({n}) must divide sample_count ({self._spp})")
             self._spw = n
             super().set_samples_per_wavefront(n)
+
+        def _mitsuba_samples_per_wavefront(self) -> int:
+            """The samples per pixel per pass Mitsuba last set (``Sampler::m_samples_per_wavefront``)."""
+            return ctypes.c_uint32.from_address(self.ptr + PyoaSampler._spw_offset).value
 
         @property
         def pyoa_sampler(self):
@@ -185,12 +243,18 @@ def _make_class(base: type) -> type:
             self._lane_sample = None
 
         def seed(self, seed, wavefront_size=MAX_UINT32) -> None:
-            super().seed(seed, wavefront_size)
+            # Mitsuba's lanes are pixels of `per_pass` samples (the count its render loop set just before
+            # seeding); this sampler's mapping holds only when that is its own count. Checked before
+            # anything changes, so a refused render leaves the sampler as it was.
             n = int(wavefront_size)
-            if n >= self._spw and n % self._spw:  # (Mitsuba seeds 1 lane to release memory after a render)
-                raise ValueError(f"pyoa sampler: a wavefront of {n} lanes is not whole pixels of {self._spw} samples: "
-                                 "Mitsuba renders in passes here (the integrator's samples_per_pass, or more than "
-                                 "2^32 samples); give the pyoa sampler the same samples_per_pass")
+            if n == MAX_UINT32:  # Mitsuba's "unspecified": the wavefront of the previous seed
+                n = self.wavefront_size()
+                if n == 0:
+                    raise ValueError("pyoa sampler: the first seed() needs the wavefront size (lanes)")
+            per_pass = self._mitsuba_samples_per_wavefront()
+            if n >= per_pass:  # (smaller: the 1-lane seed Mitsuba gives after a render to release memory)
+                self._check_wavefront(n, per_pass)
+            super().seed(seed, wavefront_size)
             lane = dr.arange(mi.UInt32, n)
             s = mi.UInt32(seed) + self._base_seed if dr.is_array_v(seed) else mi.UInt32((int(seed) + self._base_seed) % 2**32)
             # opaque, as Mitsuba's own samplers make theirs: a literal seed would be baked into the traced
@@ -203,13 +267,22 @@ def _make_class(base: type) -> type:
             self.m_pass = dr.opaque(mi.UInt32, 0)
             self._passes = 0
 
+        def _check_wavefront(self, n: int, per_pass: int) -> None:
+            """Refuse a wavefront of ``n`` lanes that Mitsuba splits into pixels of ``per_pass`` samples
+            unless this sampler maps its lanes the same way (the documented mapping)."""
+            if per_pass != self._spw:
+                mine = (f"one pass of its sample_count {self._spp}" if self._spw == self._spp
+                        else f"passes of {self._spw} (samples_per_pass)")
+                raise ValueError(
+                    f"pyoa sampler: Mitsuba renders {per_pass} samples per pixel per pass here (the integrator's "
+                    f"samples_per_pass, or fewer when one pass would exceed 2^32 samples), but this sampler is set "
+                    f"up for {mine}: give the pyoa sampler and the integrator the same samples_per_pass, a divisor "
+                    f"of sample_count {self._spp} (<integer name=\"samples_per_pass\" .../> in both), or neither")
+            if n % per_pass:
+                raise ValueError(f"pyoa sampler: a wavefront of {n} lanes is not whole pixels of {per_pass} samples")
+
         def advance(self) -> None:
             # not super().advance(): through nanobind's trampoline it calls this method again
-            if self._spw == self._spp:
-                raise RuntimeError(
-                    f"pyoa sampler: Mitsuba renders in passes (advance() was called), but this sampler was set up "
-                    f"for one pass of {self._spp} samples: give it the integrator's samples_per_pass "
-                    "(<integer name=\"samples_per_pass\" .../> in both), or render in one pass")
             self.m_dimension = dr.opaque(mi.UInt32, 0)
             self.m_pass = self.m_pass + 1
             self._passes += 1

@@ -191,7 +191,7 @@ def test_render_spp_changes_the_count_through_pyoa():
 def test_a_render_in_passes_equals_one_pass():
     """The integrator's samples_per_pass splits 121 samples into 11 passes of 11: given the same
     samples_per_pass, the sampler draws the same samples, so the image equals the one-pass image up to
-    the order of the film's float32 sums; without it the render stops at its second pass, saying why."""
+    the order of the film's float32 sums; without it the render is refused at its first seed(), saying why."""
     def scene(sampler_pass, integrator_pass):
         m = mi.cornell_box()
         m["sensor"]["film"]["width"] = m["sensor"]["film"]["height"] = 12
