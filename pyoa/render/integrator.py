@@ -4,10 +4,11 @@ tracing with next-event estimation and multiple importance sampling.
 Every lane is one camera path (pixel, sample). All random numbers of a path
 come from one row of sampler values (:mod:`.layout` says which column feeds
 what); rays are traced in bulk by Embree through ``embreex`` (float32 rays,
-no ray start distance: origins are offset along the normal; its occlusion
-answer is 0 for occluded and -1 for free); shading is vectorized NumPy in
-float64. A lane's result depends only on its own row of sampler values, so
-the image does not depend on how lanes are batched.
+no ray start distance: origins are offset along the normal by a bound on the
+float32 error at each point, :func:`offset_distance`; its occlusion answer is
+0 for occluded and -1 for free); shading is vectorized NumPy in float64.
+A lane's result depends only on its own row of sampler values, so the image
+does not depend on how lanes are batched.
 
 References
 ----------
@@ -15,7 +16,13 @@ References
    Simulation", PhD thesis, Stanford, 1997 (multiple importance sampling,
    power heuristic).
 .. [2] M. Pharr, W. Jakob, G. Humphreys, "Physically Based Rendering", 4th
-   ed., 2023, ch. 13 (path tracing) and 5.2 (thin-lens camera).
+   ed., 2023, ch. 13 (path tracing), 5.2 (thin-lens camera) and 6.8
+   (managing rounding error; 6.8.6, robust spawned ray origins).
+.. [3] C. Wächter, N. Binder, "A Fast and Robust Method for Avoiding
+   Self-Intersection", Ray Tracing Gems, ch. 6, 2019.
+.. [4] Intel Embree, tutorials/pathtracer: ``dg.eps = 32 * FLT_EPSILON *
+   max(|P.x|, |P.y|, |P.z|, ray.tfar)``, the ray start distance of every
+   secondary ray.
 """
 
 from __future__ import annotations
@@ -35,6 +42,103 @@ from .layout import Layout
 RR_DEPTH = 5
 #: Key of the Russian-roulette hash (not a sampler dimension, see layout).
 RR_KEY = 0x7FEB352D
+# The two factors below were checked with a stress test of Embree's answers:
+# new rays leaving hit points of the Cornell box (counted when they hit the
+# shape they left) and shadow rays from them to its light with the boxes
+# removed (counted when occluded), the box translated by up to 1e5 and scaled
+# from 1e-3 to 1e8 (about 250 000 rays of each kind per case), and new rays
+# leaving random triangles at coordinates 0 to 1e7, 1e-3 to 1e3 across, hit
+# by rays 1e-2 to 1e5 long (60 cases of up to 100 000 rays); many near grazing.
+
+#: Bound, relative to a coordinate, on the float32 rounding of ray origins
+#: (:func:`offset_distance`): half an ulp is at most 2^-24 of it; 2 * 2^-24 is
+#: the smallest factor without self-intersections in the stress test (1 *
+#: 2^-24 left 5e-5 of the new rays at 1e5), so 4 * 2^-24 leaves a margin of 2.
+ORIGIN_ERROR = 4 * 2.0**-24
+#: Bound, relative to the lengths it computes with (the longest edge of the
+#: triangle, the shadow segment), on the error of Embree's float32
+#: ray-triangle test, hit distance and directions (:func:`offset_distance`):
+#: 4 * 2^-24 is the smallest factor without false occlusion in the stress
+#: test (2 * 2^-24 left 1.5e-4 of the shadow rays at scale 1e-3, 1 * 2^-24
+#: 4e-3), so 16 * 2^-24 leaves a margin of 4. It costs nothing: the term is
+#: about 1e-6 of those lengths.
+TEST_ERROR = 16 * 2.0**-24
+
+
+def triangle_sizes(triangles: np.ndarray) -> np.ndarray:
+    """Longest edge of each of the ``(T, 3, 3)`` triangles (float64): how far
+    from a point of the triangle Embree's test of a ray leaving that point
+    reaches for the vertices. One edge at a time, so that a large mesh needs
+    no float64 copy of all its vertices."""
+    size = np.zeros(len(triangles))
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        e = triangles[:, b].astype(np.float64) - triangles[:, a]
+        np.maximum(size, np.sqrt(dot(e, e)), out=size)
+    return size
+
+
+def triangle_planes(triangles: np.ndarray) -> np.ndarray:
+    """Unit normals of the ``(T, 3, 3)`` triangles as stored (float32, the
+    ones Embree traces), computed in float64: the planes :func:`to_plane`
+    moves hit points onto."""
+    v0 = triangles[:, 0].astype(np.float64)
+    n = np.cross(triangles[:, 1] - v0, triangles[:, 2] - v0)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    return n
+
+
+def to_plane(p: np.ndarray, v0: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """The points ``p`` moved along the unit normals ``m`` onto the planes
+    through ``v0`` (all ``(N, 3)``).
+
+    A hit point ``o + t d`` carries the float32 error of ``t`` and of the ray
+    origin, which grows with the ray's length and the origin's coordinates;
+    on the plane of its triangle (float64 arithmetic on the float32 vertices
+    Embree traces) it has none along the normal, the only direction that
+    matters for leaving the surface. pbrt-v4 [2]_ (6.8.5) recomputes hit
+    points from barycentrics for the same reason.
+    """
+    # term by term, in the order of the compiled mirror (same bits)
+    h = (p[:, 0] - v0[:, 0]) * m[:, 0] + (p[:, 1] - v0[:, 1]) * m[:, 1] + (p[:, 2] - v0[:, 2]) * m[:, 2]
+    return p - h[:, None] * m
+
+
+def offset_distance(p: np.ndarray, n: np.ndarray, extent: np.ndarray) -> np.ndarray:
+    """How far along its unit normal ``n`` a ray must leave the surface point
+    ``p`` (``(N, 3)``) for Embree's float32 test not to find that surface
+    again. ``p`` lies on its triangle's plane (:func:`to_plane`, or a point
+    sampled on a light), and ``extent`` is how far from the new ray's origin
+    Embree's computation reaches: the longest edge of the triangle
+    (:func:`triangle_sizes`), plus, for a light sample at the end of a shadow
+    segment, the segment's length.
+
+    The offset is pbrt-v4's [2]_ ``d = dot(|n|, e)`` (6.8.6, robust spawned
+    ray origins) for a per-component bound ``e`` of what float32 rounds::
+
+        e_k = ORIGIN_ERROR |p_k| + TEST_ERROR extent
+        d   = |n_x| e_x + |n_y| e_y + |n_z| e_z
+
+    The first term bounds the rounding of the ray origin to float32, half an
+    ulp (at most ``2^-24 |p_k|``); only the coordinates along the normal
+    count (a wall at ``x = 1e5`` needs 1e5's rounding, the floor beside it
+    does not). The second bounds the errors proportional to the lengths that
+    Embree computes with, in coordinates relative to the ray origin: its
+    ray-triangle test, and for a shadow segment its float32 direction and
+    length (and its start's rounding, whose coordinates exceed ``|p_k|`` by
+    at most the segment's length). So the offset follows the point and its
+    triangle, not the largest coordinate of the scene nor the length of the
+    ray that found it: it is the same fraction of the geometry at every
+    scale, and grows with the distance from the origin only as float32's
+    spacing does, up to the limits that the scene loader checks
+    (``pyoa.render.scene._check_float32_precision``). Embree's own path
+    tracer [4]_ starts secondary rays at ``64 * 2^-24 max(|p|, t)``; Wächter
+    and Binder [3]_ move float32 hit points by 256 ulps of each coordinate.
+    Returns ``(N,)`` float64 distances.
+    """
+    s = TEST_ERROR * extent
+    a, b = np.abs(n), ORIGIN_ERROR * np.abs(p)
+    # term by term, in the order of the compiled mirror (same bits)
+    return a[:, 0] * (b[:, 0] + s) + a[:, 1] * (b[:, 1] + s) + a[:, 2] * (b[:, 2] + s)
 
 
 def _compact(keep: np.ndarray, *arrays):
@@ -100,11 +204,14 @@ class Integrator:
             raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
         self.scene, self.layout = scene, layout
         self.width, self.height, self.filter = width, height, filter
+        #: Longest edge and unit normal of each triangle as traced (float32),
+        #: for :func:`offset_distance` and :func:`to_plane`; computed before
+        #: Embree's build, so that their temporaries do not add to its peak.
+        self.sizes = triangle_sizes(scene.triangles)
+        self.planes = triangle_planes(scene.triangles)
         self._tracer = self._build_tracer(scene)
         self.camera = PerspectiveCamera(scene.camera, width, height)
         self.emitters = Emitters(scene)
-        #: Rays leave surfaces this far along the normal (Embree has no ray start distance).
-        self.eps = 1e-4 * max(1.0, float(np.abs(scene.triangles).max()))
 
     # -- rays ---------------------------------------------------------------
 
@@ -155,13 +262,14 @@ class Integrator:
         pdf_light = self.emitters.pdf_area(tri) * t**2 / np.maximum(cos_l, 1e-12)
         return np.where(prev_delta, 1.0, power_heuristic(prev_pdf, pdf_light))
 
-    def next_event(self, p, ns, tb, wo, mat, beta, u):
+    def next_event(self, p, off, ns, tb, wo, mat, beta, u):
         """Next-event estimation at the smooth lanes: one point on an emitter
         per lane (``u``: its two numbers), the BSDF and the MIS weight (power
         heuristic against BSDF sampling), and a shadow ray between the two
-        points. Returns ``(lanes, contributions)`` of the unoccluded samples,
-        and the number of shadow rays traced."""
-        sc, eps = self.scene, self.eps
+        points, the one at ``p`` moved ``off`` (:func:`offset_distance`) off
+        its surface. Returns ``(lanes, contributions)`` of the unoccluded
+        samples, and the number of shadow rays traced."""
+        sc = self.scene
         etri, q, nq, pdf_area = self.emitters.sample(u)
         to_q = q - p
         dist = np.linalg.norm(to_q, axis=1)
@@ -173,13 +281,15 @@ class Integrator:
         if len(s) == 0:
             return s, np.zeros((0, 3)), 0
         if len(s) < len(cos_q):
-            wi, f_cos, pdf_b, pdf_l, etri, q, nq = (a[s] for a in (wi, f_cos, pdf_b, pdf_l, etri, q, nq))
+            wi, f_cos, pdf_b, pdf_l, etri, q, nq, dist = (
+                a[s] for a in (wi, f_cos, pdf_b, pdf_l, etri, q, nq, dist))
         # The shadow ray runs between the two points, each moved off its
-        # surface (towards the other): from p + eps n to q + eps n_q. Measuring
-        # it from p instead let it reach the light's own plane and count the
-        # light as its own occluder.
-        start = p[s] + eps * np.where((dot(wi, ns[s]) > 0)[:, None], ns[s], -ns[s])
-        seg = q + eps * nq - start
+        # surface (towards the other) by its own float32 error bound: from
+        # p + off n to q + off_q n_q, off_q that of the end of a segment of
+        # length dist. Measuring it from p instead let it reach the
+        # light's own plane and count the light as its own occluder.
+        start = p[s] + off[s][:, None] * np.where((dot(wi, ns[s]) > 0)[:, None], ns[s], -ns[s])
+        seg = q + offset_distance(q, nq, dist + self.sizes[etri])[:, None] * nq - start
         seg_len = np.linalg.norm(seg, axis=1)
         vis = self._visible(start, seg / np.maximum(seg_len, 1e-12)[:, None], seg_len * (1 - 1e-4))
         w = power_heuristic(pdf_l, pdf_b) if self.layout.mis else np.ones(len(s))
@@ -210,7 +320,7 @@ class Integrator:
                 tri >= 0, lane, o, d, beta, prev_pdf, prev_delta, tri, t)
             if len(lane) == 0:
                 break
-            p = o + t[:, None] * d
+            p = to_plane(o + t[:, None] * d, sc.triangles[tri, 0].astype(np.float64), self.planes[tri])
             le, cos_l = self.emitted(tri, d)
             if np.any(le):
                 w = self.emission_weight(depth, tri, t, cos_l, prev_pdf, prev_delta)
@@ -220,6 +330,7 @@ class Integrator:
             # shading frame facing the incoming ray (two-sided surfaces)
             ng = sc.normals[tri]
             ns = np.where((dot(ng, d) > 0)[:, None], -ng, ng)
+            off = offset_distance(p, ng, self.sizes[tri])  # new rays leave p this far along ns
             tb = frame(ns)
             wo = to_local(-d, *tb, ns)
             wo[:, 2] = np.maximum(wo[:, 2], 1e-9)
@@ -230,7 +341,7 @@ class Integrator:
                 s = np.flatnonzero(smooth)
                 sel = slice(None) if len(s) == len(smooth) else s  # a view when every lane is smooth
                 hit, contrib, shadows = self.next_event(
-                    p[sel], ns[sel], (tb[0][sel], tb[1][sel]), wo[sel], mat[sel], beta[sel],
+                    p[sel], off[sel], ns[sel], (tb[0][sel], tb[1][sel]), wo[sel], mat[sel], beta[sel],
                     row[sel][:, L.pair(f"light{depth}")].astype(np.float64))
                 stats.rays += shadows
                 radiance[lane[s[hit]]] += contrib
@@ -244,7 +355,6 @@ class Integrator:
                 survive, beta = russian_roulette(beta, rr_key[lane], sample[lane], depth)
                 alive &= survive
             wd = to_world(wi, *tb, ns)
-            off = self.eps * np.where((dot(wd, ns) > 0)[:, None], ns, -ns)
-            lane, o, d, beta, prev_pdf, prev_delta = _compact(
-                alive, lane, p + off, wd, beta, pdf, delta)
+            o = p + off[:, None] * np.where((dot(wd, ns) > 0)[:, None], ns, -ns)
+            lane, o, d, beta, prev_pdf, prev_delta = _compact(alive, lane, o, wd, beta, pdf, delta)
         return radiance, stats

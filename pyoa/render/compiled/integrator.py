@@ -27,7 +27,7 @@ from .. import embree
 from .. import integrator as reference
 from ..bsdf import MIRROR
 from ..camera import filter_offsets
-from ..integrator import RR_KEY, Stats
+from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR, Stats
 from .bsdf import evaluate, sample
 from .camera import camera_rays
 from .emitters import sample_emitter
@@ -75,6 +75,27 @@ def emission_weight(depth, mis, pdf_light, prev_pdf, prev_delta):
 
 
 @njit(**_INLINE)
+def to_plane(px, py, pz, vx, vy, vz, mx, my, mz):
+    """The point ``p`` moved along the unit normal ``m`` onto the plane through
+    ``v``, as ``integrator.to_plane`` (the same operations in the same order,
+    so the same bits), whose docstring says why."""
+    h = (px - vx) * mx + (py - vy) * my + (pz - vz) * mz
+    return px - h * mx, py - h * my, pz - h * mz
+
+
+@njit(**_INLINE)
+def offset_distance(px, py, pz, nx, ny, nz, extent):
+    """How far along its unit normal ``n`` a ray leaves the surface point
+    ``p``: ``d = sum_k |n_k| e_k`` with the float32 error bound ``e_k =
+    ORIGIN_ERROR |p_k| + TEST_ERROR extent`` (pbrt-v4's offset of spawned ray
+    origins, 6.8.6), as ``integrator.offset_distance``, whose docstring
+    derives it; the same operations in the same order, so the same bits."""
+    s = TEST_ERROR * extent
+    return (abs(nx) * (ORIGIN_ERROR * abs(px) + s) + abs(ny) * (ORIGIN_ERROR * abs(py) + s)
+            + abs(nz) * (ORIGIN_ERROR * abs(pz) + s))
+
+
+@njit(**_INLINE)
 def russian_roulette(br, bg, bb, key, sample_index, depth):
     """``(alive, beta r, g, b)``: survival with probability ``min(max beta,
     0.95)`` from a hash of the path (as ``integrator.russian_roulette``)."""
@@ -86,7 +107,7 @@ def russian_roulette(br, bg, bb, key, sample_index, depth):
 
 
 @njit(**_JIT)
-def shade(n, depth, max_depth, mis, rr_depth, eps,
+def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
           verts, normals, areas, material, emission, kinds, colors, alphas, em, em_cdf, em_prob,
           x, light_u, light_v, bsdf_u, bsdf_v, sample_index, rr_key,
           lane, o, d, beta, prev_pdf, prev_delta, prim, t, radiance,
@@ -98,7 +119,10 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
     BSDF, plays Russian roulette and compacts the surviving lanes, in place,
     to the front of ``lane, o, d, beta, prev_pdf, prev_delta`` with their new
     rays. Returns ``(live lanes, shadow rays)``. ``light_u`` and the other
-    column indices are -1 where the layout has no such dimension.
+    column indices are -1 where the layout has no such dimension. Hit points
+    are moved onto their triangle's plane (:func:`to_plane`, ``planes``: the
+    unit normals of the triangles as traced) and new rays leave them by
+    :func:`offset_distance` (``sizes``: the longest edge of each triangle).
     """
     live, shadows = 0, 0
     for i in range(n):
@@ -108,7 +132,9 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
         li = lane[i]
         dx, dy, dz = d[i, 0], d[i, 1], d[i, 2]
         ti = t[i]
-        px, py, pz = o[i, 0] + ti * dx, o[i, 1] + ti * dy, o[i, 2] + ti * dz
+        px, py, pz = to_plane(o[i, 0] + ti * dx, o[i, 1] + ti * dy, o[i, 2] + ti * dz,
+                              verts[tri, 0, 0], verts[tri, 0, 1], verts[tri, 0, 2],
+                              planes[tri, 0], planes[tri, 1], planes[tri, 2])
         nx, ny, nz = normals[tri, 0], normals[tri, 1], normals[tri, 2]
         br, bg, bb = beta[i, 0], beta[i, 1], beta[i, 2]
         # emission seen by this ray (emitters are one-sided)
@@ -122,6 +148,7 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
             radiance[li, 2] += bb * eb * w
         if depth == max_depth:
             continue
+        eps = offset_distance(px, py, pz, nx, ny, nz, sizes[tri])  # new rays leave p this far
         # shading frame facing the incoming ray (two-sided surfaces)
         if nx * dx + ny * dy + nz * dz > 0:
             sx, sy, sz = -nx, -ny, -nz
@@ -148,10 +175,12 @@ def shade(n, depth, max_depth, mis, rr_depth, eps,
                                          wx * sx + wy * sy + wz * sz)
             pdf_l = pdf_area * dist * dist / max(cos_q, 1e-12)
             if cos_q > 0 and (fr > 0 or fg > 0 or fb > 0):
-                # from p + eps n to q + eps n_q, each moved off its surface
+                # from p + eps n to q + eps_q n_q, each moved off its surface
+                # by its own float32 error bound (q's: the end of a segment of length dist)
                 side = eps if wx * sx + wy * sy + wz * sz > 0 else -eps
                 ax, ay, az = px + side * sx, py + side * sy, pz + side * sz
-                gx, gy, gz = qx + eps * mx - ax, qy + eps * my - ay, qz + eps * mz - az
+                eq = offset_distance(qx, qy, qz, mx, my, mz, dist + sizes[etri])
+                gx, gy, gz = qx + eq * mx - ax, qy + eq * my - ay, qz + eq * mz - az
                 seg = math.sqrt(gx * gx + gy * gy + gz * gz)
                 sn = max(seg, 1e-12)
                 wl = power_heuristic(pdf_l, pdf_b) if mis else 1.0
@@ -284,7 +313,7 @@ class CompiledIntegrator(reference.Integrator):
                 cols[:2] = L.pair(f"light{depth}")
                 if f"bsdf{depth}.u" in L:
                     cols[2:] = L.pair(f"bsdf{depth}")
-            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self.eps,
+            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self.sizes, self.planes,
                                   self._verts, self._normals, self._areas, self._material, self._emission,
                                   kinds, colors, alphas, *self._em,
                                   x, *cols, sample_index, rr_key,
