@@ -85,17 +85,7 @@ def choose(backend: str | None = None, device: str | None = None):
     """
     global _warned
     _check_selector(device)
-    if backend is None:
-        backend = os.environ.get(ENV_BACKEND) or None
-        origin = f"${ENV_BACKEND}"
-    else:
-        origin = "backend"
-    if backend is not None:
-        if not isinstance(backend, str):
-            raise TypeError(f"backend must be a str or None, got {type(backend).__name__}")
-        backend = backend.strip().lower()
-        if backend not in BACKENDS:
-            raise ValueError(f"unknown {origin} {backend!r}; valid: {', '.join(BACKENDS)} (or None for automatic)")
+    backend = backend_name(backend)
     if backend == "numpy":
         return NumpyBackend()
     if backend == "opencl":
@@ -108,6 +98,33 @@ def choose(backend: str | None = None, device: str | None = None):
         if first:
             warnings.warn(fallback_message(exc), PyoaFallbackWarning, stacklevel=_first_frame_outside_pyoa())
         return NumpyBackend()
+
+
+def backend_name(backend: str | None = None) -> str | None:
+    """The backend that ``backend`` names: the argument, else
+    ``$PYOA_BACKEND``, else None (automatic), checked and in lower case.
+
+    Raises
+    ------
+    TypeError
+        A ``backend`` that is not a str or None.
+    ValueError
+        A name (of the argument or of the environment variable, which the
+        message names) that is not one of :data:`BACKENDS`.
+    """
+    if backend is None:
+        backend = os.environ.get(ENV_BACKEND) or None
+        origin, automatic = f"${ENV_BACKEND}", "unset it"
+    else:
+        origin, automatic = "backend", "None"
+    if backend is None:
+        return None
+    if not isinstance(backend, str):
+        raise TypeError(f"backend must be a str or None, got {type(backend).__name__}")
+    name = backend.strip().lower()
+    if name not in BACKENDS:
+        raise ValueError(f"unknown {origin} {name!r}; valid: {', '.join(BACKENDS)} (or {automatic} for automatic)")
+    return name
 
 
 def _check_selector(device) -> None:
@@ -160,9 +177,15 @@ def backends() -> list[dict]:
         (bool), ``used`` (bool: the device OpenCL runs on), ``reason`` and
         ``fix`` (one line each, None when it works) and ``log`` (the whole
         build log of a failure, else None).
+
+    Raises
+    ------
+    ValueError
+        ``$PYOA_BACKEND`` names no backend (as :func:`choose` raises).
     """
     from ._opencl.choice import probe_all
 
+    env = backend_name(None)  # a bad $PYOA_BACKEND is refused here as by every command, not reported as the default
     report = []
     try:
         ocl = _opencl_backend(None)
@@ -186,8 +209,7 @@ def backends() -> list[dict]:
     ]
     report.append(entry)
     report.append({"name": "numpy", "usable": True, "device": NumpyBackend().describe(), "reason": None})
-    env = (os.environ.get(ENV_BACKEND) or "").strip().lower()
-    default = env if env in BACKENDS else ("opencl" if report[0]["usable"] else "numpy")
+    default = env or ("opencl" if report[0]["usable"] else "numpy")
     for e in report:
         e["default"] = e["name"] == default
     return report

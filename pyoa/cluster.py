@@ -12,8 +12,11 @@ the place they run:
 * ``scheduler=ADDRESS`` (or ``$PYOA_SCHEDULER``): an existing Dask cluster,
   e.g. ``tcp://10.0.0.5:8786`` started with ``dask scheduler`` and
   ``dask worker ADDRESS`` on several machines (``docs/distributed.md``). An
-  address that does not answer within :data:`CONNECT_TIMEOUT` seconds is a
-  :class:`ClusterUnavailable` error naming it.
+  address that is not ``SCHEME://HOST:PORT`` (:func:`check_address`) is
+  refused before anything starts; one where no Dask scheduler answers
+  within :data:`CONNECT_TIMEOUT` seconds (nothing listening, or something
+  that is not a Dask scheduler) is a :class:`ClusterUnavailable` error
+  naming it, raised within that time.
 
 Both engines expose :meth:`InProcess.share` (a value many tasks read, sent
 once per worker) and :meth:`InProcess.run`, which yields
@@ -42,6 +45,11 @@ from .catalogue_types import check_int
 ENV_SCHEDULER = "PYOA_SCHEDULER"
 #: Seconds to wait for a scheduler to answer before giving up.
 CONNECT_TIMEOUT = 10
+#: Seconds past :data:`CONNECT_TIMEOUT` given to a connection that was
+#: accepted to answer (see :func:`_identity`).
+HANDSHAKE_GRACE = 0.5
+#: The port ``dask scheduler`` listens on unless told otherwise (for suggestions).
+DEFAULT_PORT = 8786
 #: Times a task that raised is run again on a cluster before its error is final.
 RETRIES = 2
 #: Most local worker processes (``--workers``): more than this is a typo.
@@ -173,7 +181,8 @@ def _token(fn, a) -> str:
 
 def resolve_scheduler(scheduler: str | None) -> str | None:
     """``scheduler``, else ``$PYOA_SCHEDULER``, else None (in-process); an
-    address must be a non-empty string such as ``tcp://host:8786``."""
+    address must be ``SCHEME://HOST:PORT`` such as ``tcp://host:8786``
+    (:func:`check_address`)."""
     if scheduler is None:
         scheduler = os.environ.get(ENV_SCHEDULER) or None
         origin = f"${ENV_SCHEDULER}"
@@ -183,7 +192,49 @@ def resolve_scheduler(scheduler: str | None) -> str | None:
         return None
     if not isinstance(scheduler, str) or not scheduler.strip():
         raise ValueError(f"{origin} must be a scheduler address such as tcp://10.0.0.5:8786, got {scheduler!r}")
-    return scheduler.strip()
+    return check_address(scheduler.strip(), origin)
+
+
+def check_address(address: str, origin: str = "--scheduler") -> str:
+    """``address`` checked as one distributed can connect to, with its scheme.
+
+    ``SCHEME://HOST:PORT`` with a scheme of distributed's comm registry
+    (``tcp``, ``tls``, ``ws``, ``wss``, ``ucx``; ``inproc`` addresses are
+    taken as they are); ``HOST:PORT`` alone is ``tcp://HOST:PORT``
+    (distributed's default scheme). Nothing is connected to: a bare host,
+    an empty one or a scheme that does not exist is refused before the
+    connection attempt, which would otherwise fail only after its timeout.
+
+    Raises
+    ------
+    ValueError
+        The address is none of those forms; the message names ``origin``
+        (``--scheduler`` or ``$PYOA_SCHEDULER``) and, for a bare host, the
+        address with dask's default port.
+    """
+    from distributed.comm import registry
+    from distributed.comm.addressing import parse_address, parse_host_port, unparse_address
+
+    form = (f"a scheduler address is SCHEME://HOST:PORT such as tcp://10.0.0.5:{DEFAULT_PORT}, SCHEME one of "
+            f"{', '.join(sorted(registry.backends))}")
+    scheme, loc = parse_address(address)
+    if scheme not in registry.backends:
+        raise ValueError(f"{origin} {address!r} has an unknown scheme {scheme!r}; {form}")
+    if scheme != "inproc":
+        try:
+            host, port = parse_host_port(loc, default_port=-1)  # -1: no port given
+        except ValueError as exc:
+            raise ValueError(f"{origin} {address!r} is not HOST:PORT ({exc}); {form}") from None
+        if not host:
+            raise ValueError(f"{origin} {address!r} has no host; {form}")
+        if port == -1:
+            raise ValueError(f"{origin} {address!r} has no port; a scheduler listens on {DEFAULT_PORT} unless told "
+                             f"otherwise: {scheme}://{loc}:{DEFAULT_PORT}")
+        if not 1 <= port <= 65535:
+            raise ValueError(f"{origin} {address!r} has port {port}, outside [1, 65535]; {form}")
+    elif not loc:
+        raise ValueError(f"{origin} {address!r} has no location; {form}")
+    return unparse_address(scheme, loc)
 
 
 def check_engine(workers: int | None = None, scheduler: str | None = None) -> tuple[int | None, str | None]:
@@ -197,19 +248,85 @@ def check_engine(workers: int | None = None, scheduler: str | None = None) -> tu
     return workers, scheduler
 
 
-def _connect(address: str, timeout: float):
+def _identity(address: str, timeout: float) -> dict:
+    """What the Dask server at ``address`` says it is (its ``identity``:
+    ``{"type": "Scheduler", ...}``), asked within ``timeout`` seconds.
+
+    A probe before any :class:`distributed.Client` exists: a Client whose
+    connection fails is left half-built, and its ``__del__`` later waited 20
+    s and printed a traceback; and the connection's handshake has no
+    timeout of its own (a port where something else listens held a Client
+    for a minute). Run in a thread of its own, so that it works whether or
+    not the caller runs an event loop.
+
+    Raises
+    ------
+    ClusterUnavailable
+        Nothing accepted a connection within ``timeout`` seconds, or what
+        did gave no Dask identity within :data:`HANDSHAKE_GRACE` more (the
+        message says which).
+    """
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+    from distributed.security import Security
+
+    async def ask():
+        # connect() retries until `timeout` and then raises OSError (nothing
+        # accepted a connection); its handshake that follows has no bound
+        comm = await connect(address, timeout=timeout, **Security().get_connection_args("client"))
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            await comm.close()
+
+    def run():
+        # HANDSHAKE_GRACE more than connect's own limit: an OSError of
+        # connect() reaches us as such, a hung handshake as the timeout
+        return asyncio.run(asyncio.wait_for(ask(), timeout + HANDSHAKE_GRACE))
+
     try:
+        with ThreadPoolExecutor(1) as pool:
+            info = pool.submit(run).result()
+    except (asyncio.TimeoutError, TimeoutError):
+        raise _unavailable(address, timeout + HANDSHAKE_GRACE, "something accepted the connection but did not "
+                           "answer as a Dask scheduler does: is it the scheduler's port?") from None
+    except OSError as exc:  # refused, unreachable, unknown host, closed: distributed's reason
+        raise _unavailable(address, timeout, (str(exc).strip().splitlines() or [type(exc).__name__])[0]) from None
+    except Exception as exc:  # noqa: BLE001 - whatever a decoder raises on bytes that are not Dask's messages
+        raise _unavailable(address, timeout, f"what answered does not speak Dask's protocol: it sent bytes that "
+                                             f"are not Dask messages ({type(exc).__name__})") from None
+    return info if isinstance(info, dict) else {}
+
+
+def _unavailable(address: str, timeout: float, reason: str) -> ClusterUnavailable:
+    return ClusterUnavailable(
+        f"no Dask scheduler answered at {address!r} within {timeout:g} s ({reason}); start one with "
+        f"`dask scheduler` and workers with `dask worker {address}`, or run in-process without "
+        f"--scheduler (and unset ${ENV_SCHEDULER})")
+
+
+def _connect(address: str, timeout: float):
+    """A Client of the scheduler at ``address``, once :func:`_identity` has
+    found one there (see it for why)."""
+    try:
+        import dask
         from distributed import Client
     except ImportError as exc:  # pragma: no cover - dask is a dependency
         raise ImportError('running on a cluster needs Dask: pip install "dask[distributed]"') from exc
-    try:
-        return Client(address, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+    kind = _identity(address, timeout).get("type")
+    if kind != "Scheduler":
         raise ClusterUnavailable(
-            f"no Dask scheduler answered at {address!r} within {timeout:g} s ({first}); start one with "
-            f"`dask scheduler` and workers with `dask worker {address}`, or run in-process without "
-            f"--scheduler (and unset ${ENV_SCHEDULER})") from None
+            f"{address!r} is a Dask {kind or 'server'}, not a scheduler; give the address that `dask scheduler` "
+            f"prints (port {DEFAULT_PORT} unless told otherwise), or run in-process without --scheduler (and "
+            f"unset ${ENV_SCHEDULER})")
+    try:
+        with dask.config.set({"distributed.comm.timeouts.connect": timeout}):
+            return Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:  # the scheduler went away since it answered
+        raise _unavailable(address, timeout, (str(exc).strip().splitlines() or [type(exc).__name__])[0]) from None
 
 
 @contextlib.contextmanager

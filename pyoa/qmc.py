@@ -128,7 +128,7 @@ class OrthogonalArray(qmc.QMCEngine):
         Largest array one `random` call may return (``"4G"``, ``0.25`` of
         RAM...; see :func:`pyoa.sampler`): a larger draw raises a ValueError
         naming the limit before anything is allocated. Default
-        ``$PYOA_MAX_BYTES``, else half the physical memory.
+        ``$PYOA_MAX_BYTES``, else half the memory the process may use.
 
     Attributes
     ----------

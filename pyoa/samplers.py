@@ -189,6 +189,20 @@ _int = check_int  # the checker of every count argument (pyoa.analysis uses it t
 #: Bytes per index of a request: pixels, samples and dims are held as uint32.
 INDEX_BYTES = 4
 
+#: Most chunks of one :meth:`Sampler.to_dask` array. Its graph is one lazy
+#: layer whatever the count, but Dask itself keeps every chunk's size and
+#: offset (about 60 bytes a chunk: 3 s and 0.5 GB at 10**7 chunks), and
+#: computing the whole array makes a task of about 1 KB per chunk on the
+#: scheduler; a million chunks (about 0.5 s and 64 MB to build) is far more
+#: than any useful chunking of the values and far less than a machine's
+#: memory.
+MAX_DASK_CHUNKS = 10**6
+#: The axes of a :meth:`Sampler.generate` result, as error messages name them.
+_AXES = ("pixels", "samples", "dims")
+_CHUNK_FORMS = ("valid chunks: 'auto', a size such as '64MiB', an int >= 1 for every axis, or one entry per axis "
+                "(pixels, samples, dims) as a 3-tuple or a dict {axis number: entry}, each entry an int >= 1, -1 or "
+                "None (the whole axis), 'auto', or a tuple of chunk sizes (ints >= 1) adding up to the axis length")
+
 
 def _index_kind_error(name: str, value) -> TypeError:
     if isinstance(value, numbers.Integral) and not isinstance(value, bool):
@@ -525,9 +539,11 @@ class Sampler:
         array can be written straight to disk (``arr.to_zarr(...)``), kept in
         a Dask cluster's memory (``arr.persist()``), or reduced chunk by
         chunk. Each chunk is computed where it is needed, by the worker that
-        needs it: the graph holds only the sampler's parameters (it pickles
-        as them, see :class:`Sampler`) and each chunk's indices, never
-        sample values shipped from the client. A worker process rebuilds the
+        needs it: the graph is one lazy layer (a chunk's task is made only
+        when a computation needs that chunk) and one key holding the
+        sampler's parameters (it pickles as them, see :class:`Sampler`) and
+        the index arguments, never sample values shipped from the client.
+        A worker process rebuilds the
         sampler with the same backend name and device selector, so an
         OpenCL sampler needs OpenCL on the workers.
 
@@ -539,11 +555,15 @@ class Sampler:
             Sample indices in ``[0, spp)``; default every sample.
         dims : range or sequence of int, optional
             Dimensions in ``[0, dims)``; default every dimension.
-        chunks : int, tuple, dict or "auto"
+        chunks : int, str, tuple or dict
             Chunk sizes over the three axes ``(pixels, samples, dims)``, in
-            any form :func:`dask.array.core.normalize_chunks` accepts (``-1``
-            or None for a whole axis; a dict maps an axis to its chunks, the
-            others whole). ``"auto"`` (default): chunks of about Dask's
+            the forms :func:`dask.array.core.normalize_chunks` reads: an int
+            ``>= 1`` for every axis; a size in bytes (``"64MiB"``); or one
+            entry per axis as a 3-tuple, or a dict ``{axis number: entry}``
+            (the others whole), each entry an int ``>= 1``, ``-1`` or None
+            (the whole axis), ``"auto"``, or a tuple of chunk sizes (ints
+            ``>= 1``) adding up to the axis length. At most
+            :data:`MAX_DASK_CHUNKS` chunks in all. ``"auto"`` (default): chunks of about Dask's
             ``array.chunk-size`` (128 MiB unless configured; at most half of
             ``max_bytes``), each whole ``samples x dims`` rows of a run of
             pixels where one row fits, else split along samples, then dims.
@@ -559,8 +579,14 @@ class Sampler:
         ------
         ValueError, TypeError
             At once, not at compute time: the errors :meth:`generate` raises
-            for its index arguments, or a chunk larger than ``max_bytes``
-            (the limit is per chunk; the whole array may be larger).
+            for its index arguments; chunks in none of the forms above (a
+            chunk size of 0 or below other than -1, a float, sizes that do
+            not add up to the axis length, an axis number other than 0, 1,
+            2), each message naming the axis and the valid forms; more than
+            :data:`MAX_DASK_CHUNKS` chunks (counted before any is listed;
+            the message suggests a chunking that fits); or a chunk larger
+            than ``max_bytes`` (the limit is per chunk; the whole array may
+            be larger).
         ImportError
             Dask is not installed.
 
@@ -588,7 +614,6 @@ class Sampler:
             import dask
             import dask.array as da
             from dask.base import tokenize
-            from dask.highlevelgraph import HighLevelGraph
             from dask.utils import parse_bytes as dask_bytes
         except ImportError as exc:
             raise ImportError('Sampler.to_dask needs Dask: pip install "dask[distributed]"') from exc
@@ -602,18 +627,18 @@ class Sampler:
         shape = tuple(_index_length(axis, value, size) for axis, value, size in checks)
         axes = [value if isinstance(value, range) else _indices(axis, value, size) for axis, value, size in checks]
 
+        auto_limit = min(dask_bytes(dask.config.get("array.chunk-size")), max(self.max_bytes // 2, 1))
         if isinstance(chunks, str) and chunks == "auto":
-            limit = min(dask_bytes(dask.config.get("array.chunk-size")), max(self.max_bytes // 2, 1))
             row = 4 * shape[1] * shape[2]
             if 0 in shape:  # nothing to split (and Dask's "auto" divides by the row size)
-                chunks = (-1, -1, -1)
-            elif row <= limit:
-                chunks = ("auto", -1, -1)
+                spec = (-1, -1, -1)
+            elif row <= auto_limit:
+                spec = ("auto", -1, -1)
             else:
-                chunks = (1, "auto", -1) if 4 * shape[2] <= limit else (1, 1, "auto")
-            chunks = da.core.normalize_chunks(chunks, shape, limit=limit, dtype=np.float32)
+                spec = (1, "auto", -1) if 4 * shape[2] <= auto_limit else (1, 1, "auto")
+            chunks = _dask_chunks(spec, shape, auto_limit, self.max_bytes, auto_limit, given="auto")
         else:
-            chunks = da.core.normalize_chunks(chunks, shape, dtype=np.float32)
+            chunks = _dask_chunks(chunks, shape, None, self.max_bytes, auto_limit)
         largest = [max(c, default=0) for c in chunks]
         nbytes = 4 * math.prod(largest) + INDEX_BYTES * sum(largest)
         if nbytes > self.max_bytes:
@@ -623,17 +648,17 @@ class Sampler:
                 f"or raise the limit with max_bytes= or ${ENV_MAX_BYTES}"
             )
 
+        # One lazy (Blockwise) layer whose task for block (i, j, k) is made
+        # only when a computation needs it: a graph of one task per chunk
+        # built here took 0.5 GB at a million chunks. The sampler, the index
+        # arguments and each axis's chunk offsets are one separate key that
+        # every task reads (as dask's from_array holds its array), so a
+        # worker receives them once, not once per task.
         name = f"pyoa-{self.name}-" + tokenize(self.name, self._arguments(), *axes, chunks)
-        parts = []  # per axis: (block number, that block's indices)
-        for value, sizes in zip(axes, chunks):
-            ends = np.cumsum(sizes).tolist()
-            parts.append([(k, value[end - size:end]) for k, (size, end) in enumerate(zip(sizes, ends))])
-        layer = {
-            (name, i, j, k): (_dask_block, self, p, s, d)
-            for i, p in parts[0] for j, s in parts[1] for k, d in parts[2]
-        }
-        graph = HighLevelGraph.from_collections(name, layer, dependencies=())
-        return da.Array(graph, name, chunks, dtype=np.float32, meta=np.empty((0, 0, 0), np.float32))
+        starts = tuple(np.concatenate(([0], np.cumsum(c, dtype=np.int64))) for c in chunks)
+        state = dask.delayed((self, tuple(axes), starts), pure=True, traverse=False, name=f"{name}-indices")
+        return da.map_blocks(_dask_block, state, chunks=chunks, dtype=np.float32, name=name,
+                             meta=np.empty((0, 0, 0), np.float32))
 
     def value(self, pixel: int, i: int, j: int) -> float:
         """One value, computed by the pure-Python reference.
@@ -653,9 +678,128 @@ def _rebuild(name: str, arguments: dict) -> Sampler:
     return Sampler(name, **arguments)
 
 
-def _dask_block(smp: Sampler, pixels, samples, dims) -> np.ndarray:
-    """One chunk of :meth:`Sampler.to_dask`: a task of its graph."""
-    return smp.generate(pixels, samples, dims)
+def _dask_block(state: tuple, block_id: tuple[int, int, int] | None = None) -> np.ndarray:
+    """One chunk of :meth:`Sampler.to_dask`, a task of its graph: ``state``
+    is ``(sampler, (pixels, samples, dims), starts)`` (each axis's chunk
+    offsets), ``block_id`` the chunk's position (given by Dask)."""
+    smp, axes, starts = state
+    return smp.generate(*(value[int(s[b]):int(s[b + 1])] for value, s, b in zip(axes, starts, block_id)))
+
+
+def _chunk_entries(chunks) -> tuple:
+    """``chunks`` of :meth:`Sampler.to_dask` as one entry per axis (a dict
+    or a 3-sequence entry by entry; anything else is every axis's entry)."""
+    if isinstance(chunks, Mapping):
+        for key in chunks:
+            if isinstance(key, bool) or not isinstance(key, numbers.Integral) or not 0 <= key < len(_AXES):
+                raise ValueError(f"chunks {{axis: entry}} needs axis 0 (pixels), 1 (samples) or 2 (dims), got "
+                                 f"{key!r}; {_CHUNK_FORMS}")
+        return tuple(chunks.get(axis) for axis in range(len(_AXES)))
+    if isinstance(chunks, (tuple, list)):
+        if len(chunks) != len(_AXES):
+            raise ValueError(f"chunks has {len(chunks)} entries, the array 3 axes (pixels, samples, dims); "
+                             f"{_CHUNK_FORMS}")
+        return tuple(chunks)
+    return (chunks,) * len(_AXES)
+
+
+def _chunk_count(axis: str, entry, n: int) -> int | None:
+    """How many chunks ``entry`` makes of an axis of length ``n``, known
+    before Dask lists them (None for "auto" or a size in bytes: Dask picks);
+    an entry of a kind or value Dask would misread (``0`` divides by zero,
+    ``2.5`` is truncated, ``True`` is 1) is refused here."""
+    if entry is None:
+        return 1
+    if isinstance(entry, str):
+        return None
+    if isinstance(entry, bool) or not isinstance(entry, (numbers.Integral, tuple, list)):
+        raise TypeError(f"chunks for the {axis} axis must be an int, None, 'auto' or a tuple of ints, got "
+                        f"{type(entry).__name__} {entry!r}; {_CHUNK_FORMS}")
+    if isinstance(entry, numbers.Integral):
+        if entry == -1:
+            return 1
+        if entry < 1:
+            raise ValueError(f"chunks for the {axis} axis must be >= 1, or -1 for the whole axis, got {entry}; "
+                             f"{_CHUNK_FORMS}")
+        return max(1, -(-n // int(entry)))
+    for size in entry:
+        if isinstance(size, bool) or not isinstance(size, numbers.Integral):
+            raise TypeError(f"chunk sizes of the {axis} axis must be ints, got {type(size).__name__} {size!r}; "
+                            f"{_CHUNK_FORMS}")
+    return len(entry)
+
+
+def _dask_chunks(chunks, shape: tuple[int, int, int], limit: int | None, max_bytes: int, auto_limit: int,
+                 given=None) -> tuple[tuple[int, ...], ...]:
+    """``chunks`` of :meth:`Sampler.to_dask` as Dask's chunks of ``shape``.
+
+    Dask's own :func:`dask.array.core.normalize_chunks` reads the forms; what
+    it lets through is then checked: every chunk an int >= 1 (``(0,)`` for an
+    empty axis) and each axis's chunks adding up to its length (Dask keeps
+    ``(5, -3, 8)`` as given). The chunks are counted before Dask lists them
+    (a list of 4 billion one-pixel chunks would fill the memory): more than
+    :data:`MAX_DASK_CHUNKS` is refused with a chunking that fits. ``limit``
+    is the size of an "auto" chunk (None: Dask's ``array.chunk-size``),
+    ``auto_limit`` that of ``chunks="auto"`` (for the suggestion), ``given``
+    what the user wrote (for messages; default ``chunks``).
+    """
+    import reprlib
+
+    import dask
+    from dask.array.core import normalize_chunks
+    from dask.utils import parse_bytes as dask_bytes
+
+    given = chunks if given is None else given
+    entries = _chunk_entries(chunks)
+    counts = [_chunk_count(axis, entry, n) for axis, entry, n in zip(_AXES, entries, shape)]
+    if None in counts:  # "auto" chunks of about `limit` bytes each (a size in bytes sets the limit)
+        sizes = [e for e in entries if isinstance(e, str) and e != "auto"]
+        try:
+            size = dask_bytes(sizes[0]) if sizes else limit or dask_bytes(dask.config.get("array.chunk-size"))
+        except ValueError as exc:
+            raise ValueError(f"chunks={reprlib.repr(given)}: {exc}; {_CHUNK_FORMS}") from None
+        if size < 1:
+            raise ValueError(f"chunks={reprlib.repr(given)}: a chunk size must be at least 1 byte; {_CHUNK_FORMS}")
+        fixed = math.prod(c for c in counts if c is not None)
+        _check_chunk_count(max(fixed, -(-4 * math.prod(shape) // size)), given, shape, max_bytes, auto_limit,
+                           about=True)
+    else:
+        _check_chunk_count(math.prod(counts), given, shape, max_bytes, auto_limit)
+    try:
+        normalized = normalize_chunks(entries, shape, limit=limit, dtype=np.float32)
+    except (ValueError, TypeError, ZeroDivisionError) as exc:
+        raise ValueError(f"chunks={reprlib.repr(given)}: {str(exc).splitlines()[0]}; {_CHUNK_FORMS}") from None
+    for axis, sizes, n in zip(_AXES, normalized, shape):
+        if sum(sizes) != n or (n and min(sizes) < 1):
+            raise ValueError(f"chunks of the {axis} axis must be ints >= 1 adding up to its length {n}, got "
+                             f"{reprlib.repr(sizes)}; {_CHUNK_FORMS}")
+    _check_chunk_count(math.prod(map(len, normalized)), given, shape, max_bytes, auto_limit)
+    return normalized
+
+
+def _check_chunk_count(count: int, given, shape: tuple[int, int, int], max_bytes: int, auto_limit: int,
+                       about: bool = False) -> None:
+    """Refuse more than :data:`MAX_DASK_CHUNKS` chunks (``count``, an
+    estimate where ``about``), suggesting a chunking within it: whole
+    ``samples x dims`` rows of enough pixels where such a chunk fits
+    ``max_bytes``, else ``"auto"`` where it makes few enough."""
+    if count <= MAX_DASK_CHUNKS:
+        return
+    import reprlib
+
+    n_p, n_s, n_d = shape
+    per = -(-n_p // MAX_DASK_CHUNKS)
+    nbytes = 4 * per * n_s * n_d + INDEX_BYTES * (per + n_s + n_d)
+    if nbytes <= max_bytes:
+        hint = f"use larger chunks, e.g. chunks=({per}, -1, -1) ({format_bytes(nbytes)} each)"
+    elif -(-4 * math.prod(shape) // auto_limit) <= MAX_DASK_CHUNKS:
+        hint = f"use larger chunks, e.g. chunks='auto' (about {format_bytes(auto_limit)} each)"
+    else:
+        hint = (f"ask for fewer values per array (this one has {n_p} x {n_s} x {n_d}), or raise the memory limit "
+                f"of a chunk with max_bytes= or ${ENV_MAX_BYTES} (now {format_bytes(max_bytes)})")
+    raise ValueError(f"chunks={reprlib.repr(given)} makes {'about ' if about else ''}{count:,} chunks of the "
+                     f"{n_p} x {n_s} x {n_d} array, over the {MAX_DASK_CHUNKS:,} that Sampler.to_dask allows (Dask "
+                     f"keeps every chunk's size and offset, and makes a task of each chunk computed); {hint}")
 
 
 def _offset(construction, offset):
@@ -775,7 +919,7 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         plus its index arrays): an int of bytes, a string with a unit
         (``"4G"``, ``"512MiB"``), or a fraction of RAM in (0, 1] (``0.25``,
         ``"0.25"``); see :func:`parse_bytes`. Default ``$PYOA_MAX_BYTES``
-        (same forms), else half the physical memory.
+        (same forms), else half the memory the process may use.
 
     Examples
     --------
