@@ -8,7 +8,11 @@ default, or on a Dask cluster. Rows are appended to ``DIR/study.csv`` as
 results arrive, so an interrupted study resumes and renders only what is
 missing; ``DIR/study.json`` holds the settings every row depends on (scene
 contents, size, crop, path length, filter, shading, references) and a study
-of other settings is refused rather than mixed in.
+of other settings is refused rather than mixed in. Rows and settings name a
+sampler by its catalogue name (``BOSE`` is stored as ``bose``); a reference
+is identified by its pixels (:func:`pixel_identity`) and the settings that
+rendered it, never by its file's bytes. One run at a time holds the
+directory (:func:`lock_study`).
 
 The report (``DIR/study.md``, :func:`report`):
 
@@ -40,13 +44,16 @@ References
 from __future__ import annotations
 
 import csv
+import fcntl
 import hashlib
 import io
 import json
 import math
 import os
+import socket
+import sys
 import time
-from contextlib import closing
+from contextlib import closing, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -69,6 +76,11 @@ FIELDS = ("scene", "sampler", "spp_asked", "spp", "seed", "relmse", "relmse_crop
 STUDY_VERSION = 1
 #: Most seeds per (scene, sampler, spp): a typo guard.
 MAX_SEEDS = 1 << 16
+#: The lock file of a study's directory (:func:`lock_study`).
+LOCK_NAME = ".lock"
+#: Prefix of a reference's identity in study.json (:func:`pixel_identity`). A
+#: bare SHA-256 there is the older identity, the digest of the file's bytes.
+PIXELS = "pixels-sha256:"
 
 
 def parse_list(text: str, what: str) -> list[str]:
@@ -91,12 +103,20 @@ def parse_spp(text: str) -> list[int]:
     return sorted(set(out))
 
 
+def canonical_sampler(name: str) -> str:
+    """The catalogue's own spelling of a sampler name (the catalogue looks
+    names up case-insensitively: ``BOSE`` is ``bose``); an unknown name fails,
+    with the valid ones listed."""
+    return catalogue.get(name).name
+
+
 def sampler_names(text: str) -> list[str]:
-    """``--samplers`` as checked catalogue names (``all``: every sampler)."""
-    names = catalogue.names() if str(text).strip() == "all" else parse_list(text, "--samplers")
-    for n in names:
-        catalogue.get(n)  # unknown names fail here, with the valid ones listed
-    return names
+    """``--samplers`` as distinct catalogue names, in the catalogue's spelling
+    (``all``: every sampler). Rows, settings and the report compare these
+    names, so ``--samplers BOSE`` continues a study of ``bose``."""
+    if str(text).strip().lower() == "all":
+        return catalogue.names()
+    return list(dict.fromkeys(canonical_sampler(n) for n in parse_list(text, "--samplers")))
 
 
 @dataclass(frozen=True)
@@ -115,12 +135,34 @@ class Job:
 
 
 def file_digest(path) -> str:
-    """SHA-256 of a file's bytes."""
+    """SHA-256 of a file's bytes (a reference's identity in a study.json of
+    pyoa before :func:`pixel_identity`)."""
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def pixel_identity(pixels: np.ndarray) -> str:
+    """A reference's identity: the SHA-256 of its shape and its float32 RGB
+    pixels (little-endian). Not of its file: writing the same pixels again
+    (an EXR carries the time it was written) keeps the identity."""
+    a = np.ascontiguousarray(pixels, dtype="<f4")
+    h = hashlib.sha256(repr(a.shape).encode())
+    h.update(a.tobytes())
+    return PIXELS + h.hexdigest()
+
+
+def is_reference(saved: str | None, path: Path, pixels: np.ndarray) -> bool:
+    """Whether the identity ``saved`` (study.json's) is the reference
+    ``path`` with ``pixels``: its pixel identity, or, in a study.json written
+    before pixel identities, the SHA-256 of the file's bytes."""
+    if saved is None:
+        return False
+    if saved.startswith(PIXELS):
+        return saved == pixel_identity(pixels)
+    return saved == file_digest(path)
 
 
 # -- the study's directory: settings, rows ------------------------------------------------------
@@ -144,34 +186,148 @@ def check_out_dir(out) -> Path:
     return d
 
 
-def check_settings(path: Path, settings: dict) -> dict:
-    """The settings to save in ``study.json``: ``settings``, merged with a
-    saved study's when every setting both have agrees; otherwise a
-    ValueError naming the first difference (rows of other settings are
-    never mixed in)."""
+@contextmanager
+def lock_study(d: Path):
+    """Hold the study directory ``d`` for one run: an exclusive
+    :func:`fcntl.flock` on ``d/.lock``, which names the holder (``PID
+    HOST``). A second run on the same directory is refused at once (two runs
+    would append every row twice). The lock is the open file's, so the
+    system releases it when the holder exits, however it exits; the file
+    stays (removing it would let a third run lock a new file while the
+    second waits on the old one)."""
+    path = d / LOCK_NAME
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as exc:
+        raise type(exc)(f"--out: cannot create {str(path)!r}, the study's lock file: {exc.strerror}") from None
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 512, 0).decode(errors="replace").split()
+            who = (f"process {holder[0]} on {holder[1]}" if len(holder) == 2 and holder[0].isdigit()
+                   else "another process")  # the holder has not written its name yet
+            raise ValueError(f"study directory {d} is in use by {who}; wait for it or use another --out") from None
+        except OSError as exc:  # a file system without locks
+            raise type(exc)(f"--out: cannot lock {str(path)!r} ({exc.strerror}); give an --out on a file system "
+                            "with file locks") from None
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+class Damaged(ValueError):
+    """A study.json field that pyoa did not write (the message names it)."""
+
+
+def _is_int(v, lo: int | None = None) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool) and (lo is None or v >= lo)
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v >= 0
+
+
+def _is_list(v, n: int, item) -> bool:
+    return isinstance(v, list) and len(v) == n and all(map(item, v))
+
+
+def _is_str(v) -> bool:
+    return isinstance(v, str)
+
+
+#: The fields of study.json as pyoa writes them: name -> (required, what it must be, check).
+_SETTINGS = {
+    "version": (True, "an integer", _is_int),
+    "size": (True, "a list of 2 integers >= 1", lambda v: _is_list(v, 2, lambda x: _is_int(x, 1))),
+    "crop": (True, "a list of 4 integers >= 0", lambda v: _is_list(v, 4, lambda x: _is_int(x, 0))),
+    "max_depth": (True, "null or an integer >= 1", lambda v: v is None or _is_int(v, 1)),
+    "filter": (True, "a string", _is_str),
+    "shading": (True, "a string", _is_str),
+    "scenes": (True, "an object of scenes", lambda v: isinstance(v, dict)),
+    "runs": (False, "a list of runs", lambda v: isinstance(v, list)),
+}
+#: Each of ``scenes``.
+_SCENE = {
+    "digest": (True, "a string", _is_str),
+    "reference": (False, "null or a string", lambda v: v is None or _is_str(v)),
+    "reference_name": (False, "a string", _is_str),
+    "reference_spp": (False, "null or an integer >= 1", lambda v: v is None or _is_int(v, 1)),
+    "reference_passes": (False, "null or an integer >= 1", lambda v: v is None or _is_int(v, 1)),
+    "noise": (False, "null or a list of 2 numbers >= 0", lambda v: v is None or _is_list(v, 2, _is_number)),
+}
+#: Each of ``runs``.
+_RUN = {
+    "seconds": (True, "a number >= 0", _is_number),
+    "rendered": (False, "an integer >= 0", lambda v: _is_int(v, 0)),
+    "where": (False, "a string", _is_str),
+    "date": (False, "a string", _is_str),
+    "note": (False, "a string", _is_str),
+}
+
+
+def _check_fields(obj, fields: dict, where: str) -> None:
+    """Raise :class:`Damaged` at the first field of ``obj`` (``where`` names
+    it) that is missing or not what pyoa writes."""
+    if not isinstance(obj, dict):
+        raise Damaged(f"{where or 'its top level'} is not an object")
+    for name, (required, what, test) in fields.items():
+        if name not in obj:
+            if required:
+                raise Damaged(f"{where + ' ' if where else ''}has no {name!r}")
+        elif not test(obj[name]):
+            raise Damaged(f"{where + '.' if where else ''}{name} is {json.dumps(obj[name])[:40]}, not {what}")
+
+
+def load_settings(path: Path) -> dict | None:
+    """A study's saved settings (``study.json``), checked field by field
+    before anything uses them; None when there is none. A file that is not
+    JSON, of another version, or with a field pyoa did not write is refused
+    (ValueError naming the file and the field), before any render."""
     if not path.exists():
-        return settings
+        return None
+    afresh = (f"the file is damaged: move it and {path.parent / 'study.csv'} away to start the study afresh, or "
+              "give another --out")
     try:
         saved = json.loads(path.read_text())
     except (OSError, ValueError) as exc:
-        raise ValueError(f"{path} is not a study's settings ({type(exc).__name__}); remove it, or give another "
-                         "--out") from None
-    if not isinstance(saved, dict) or saved.get("version") != STUDY_VERSION:
+        raise ValueError(f"{path} is not a study's settings ({type(exc).__name__}); {afresh}") from None
+    if isinstance(saved, dict) and _is_int(saved.get("version")) and saved["version"] != STUDY_VERSION:
         raise ValueError(f"{path} was written by another pyoa version; give another --out")
+    try:
+        _check_fields(saved, _SETTINGS, "")
+        for name, scene in saved["scenes"].items():
+            _check_fields(scene, _SCENE, f"scenes[{json.dumps(name)}]")
+        for k, r in enumerate(saved.get("runs", [])):
+            _check_fields(r, _RUN, f"runs[{k}]")
+    except Damaged as exc:
+        raise ValueError(f"{path}: {exc}; {afresh}") from None
+    return saved
+
+
+def check_settings(out: Path, saved: dict | None, settings: dict) -> dict:
+    """The settings to save in ``study.json``: ``settings``, merged with the
+    saved ones (:func:`load_settings`) when every setting both have agrees;
+    otherwise a ValueError naming the first difference (rows of other
+    settings are never mixed in). A scene's reference is checked apart
+    (:func:`plan_references`)."""
+    if saved is None:
+        return settings
     for field in ("size", "crop", "max_depth", "filter", "shading"):
-        if saved.get(field) != settings[field]:
-            raise ValueError(f"{path.parent} holds a study made with {field} {saved.get(field)}, not "
-                             f"{settings[field]}; give another --out to start a new study")
-    scenes = dict(saved.get("scenes") or {})
+        if saved[field] != settings[field]:
+            raise ValueError(f"{out} holds a study made with {field} {saved[field]}, not {settings[field]}; give "
+                             "another --out to start a new study")
+    scenes = dict(saved["scenes"])
     for name, s in settings["scenes"].items():
         old = scenes.get(name)
         if old is not None:
-            for field, say in (("digest", "other scene contents"), ("reference", "another reference")):
-                if old.get(field) is not None and s.get(field) is not None and old[field] != s[field]:
-                    raise ValueError(f"{path.parent} holds {name} renders made with {say}; give another --out")
+            if old["digest"] != s["digest"]:
+                raise ValueError(f"{out} holds {name} renders made with other scene contents; give another --out")
             s = {**old, **{k: v for k, v in s.items() if v is not None}}
         scenes[name] = s
-    return {**settings, "scenes": scenes, "runs": list(saved.get("runs") or [])}
+    return {**settings, "scenes": scenes, "runs": list(saved.get("runs", []))}
 
 
 def write_settings(path: Path, settings: dict) -> None:
@@ -179,8 +335,14 @@ def write_settings(path: Path, settings: dict) -> None:
         tmp.write_text(json.dumps(settings, indent=1, sort_keys=True) + "\n")
 
 
+def ident(row: dict) -> tuple:
+    """What tells a row apart: (scene, sampler, spp asked, seed)."""
+    return (row["scene"], row["sampler"], row["spp_asked"], row["seed"])
+
+
 def _row(raw: dict) -> dict | None:
-    """A CSV row with its types, or None if it is not a complete row."""
+    """A CSV row with its types and the sampler's catalogue name, or None
+    if it is not a complete row."""
     try:
         row = {"scene": raw["scene"], "sampler": raw["sampler"]}
         for k in ("spp_asked", "spp", "seed"):
@@ -191,13 +353,20 @@ def _row(raw: dict) -> dict | None:
         return None
     if not all(math.isfinite(row[k]) and row[k] >= 0 for k in ("relmse", "relmse_crop", "mse")):
         return None
+    if row["sampler"].lower() in catalogue.SAMPLERS:  # rows of pyoa before canonical names: BOSE is bose
+        row["sampler"] = canonical_sampler(row["sampler"])
     return row
 
 
-def read_rows(path: Path) -> list[dict]:
-    """The complete rows of ``study.csv``; a line cut short by an
-    interruption is dropped, and the file rewritten without it. A file that
-    is not a study's CSV is refused."""
+def read_rows(path: Path, repair: bool = False) -> list[dict]:
+    """The complete rows of ``study.csv``, once each. A line cut short by an
+    interruption is dropped; so is a second row of the same (scene, sampler,
+    spp asked, seed) as an earlier one with the same measurements (two runs
+    at once on one directory appended every row twice), while two such rows
+    that disagree are refused. Sampler names are read as the catalogue
+    spells them. With ``repair`` (the study's own run, holding the lock) the
+    file is rewritten that way when it differs, saying so on stderr. A file
+    that is not a study's CSV is refused."""
     if not path.exists():
         return []
     text = path.read_text()
@@ -207,20 +376,43 @@ def read_rows(path: Path) -> list[dict]:
     if lines[0].strip() != ",".join(FIELDS):
         raise ValueError(f"{path} is not a pyoa study's CSV (its header is not {','.join(FIELDS)}); give another "
                          "--out")
-    rows, kept = [], [lines[0]]
-    for line in lines[1:]:
+    rows, first, dropped, renamed, cut = [], {}, 0, 0, 0
+    for number, line in enumerate(lines[1:], 2):
         if not line.endswith("\n"):
-            continue  # the last row, cut short when the study was killed
+            cut += 1  # the last row, cut short when the study was killed
+            continue
         raw = next(csv.DictReader(io.StringIO(lines[0] + line)), None)
         row = _row(raw) if raw else None
         if row is None:
             raise ValueError(f"{path}: a row that is not a study's: {line.strip()!r}; remove the file, or give "
                              "another --out")
+        renamed += row["sampler"] != raw["sampler"]
+        seen = first.get(ident(row))
+        if seen is not None:
+            k, earlier = seen
+            if any(earlier[f] != row[f] for f in ("spp", "relmse", "relmse_crop", "mse")):
+                raise ValueError(f"{path}: lines {k} and {number} are two renders of {row['scene']} with "
+                                 f"{row['sampler']} at {row['spp_asked']} spp, seed {row['seed']}, with different "
+                                 "errors: renders of other settings were mixed in; give another --out")
+            dropped += 1
+            continue
+        first[ident(row)] = (number, row)
         rows.append(row)
-        kept.append(line)
-    if len(kept) != len(lines):
+    if repair and (cut or dropped or renamed):
+        buf = io.StringIO()
+        writer = csv.DictWriter(buf, fieldnames=FIELDS, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows({k: r[k] for k in FIELDS} for r in rows)
         with atomic_path(path) as tmp:
-            tmp.write_text("".join(kept))
+            tmp.write_text(buf.getvalue())
+        said = []  # a cut line goes without a word, as it always has
+        if dropped:
+            said.append(f"dropped {dropped} duplicate row{'s' * (dropped != 1)} (a scene, sampler, spp and seed "
+                        "already there: each counts once)")
+        if renamed:
+            said.append(f"renamed the sampler of {renamed} row{'s' * (renamed != 1)} as the catalogue spells it")
+        if said:
+            print(f"pyoa study: {path}: {' and '.join(said)}; rewrote the file", file=sys.stderr)
     return rows
 
 
@@ -460,17 +652,106 @@ def _reference_noise(ref_path: Path, ref: np.ndarray, crop) -> tuple[float, floa
     return relmse_noise(var, ref), relmse_noise(var, ref, crop)
 
 
+@dataclass
+class ReferencePlan:
+    """What a study does for one scene's reference before its renders."""
+
+    path: Path
+    pixels: np.ndarray | None = None  # ready to use; None: render it first
+    key: dict | None = None  # the reference's settings (pyoa.render.reference.reference_key) when rendered
+    made_with: dict | None = None  # study.json's record of the settings that rendered it
+
+
+def _in_passes(spp: int, passes: int) -> str:
+    return f"{spp} spp in {passes} pass{'es' * (passes != 1)} of {spp // passes}"
+
+
+def _made_with(saved: dict) -> str:
+    """The reference a saved scene record names, as the user made it."""
+    spp, passes = saved.get("reference_spp"), saved.get("reference_passes")
+    if spp and passes:
+        return f"a reference of {_in_passes(spp, passes)} (--reference-spp {spp} --pass-spp {spp // passes})"
+    return f"the given reference {saved.get('reference_name', '?')}"
+
+
+def _read_own(path: Path, saved: dict, dims) -> np.ndarray | None:
+    """The pixels of the study's own reference file when study.json names
+    it, else None (missing, unreadable, of another size or other pixels)."""
+    from .render.image import read_reference
+
+    if not path.is_file():
+        return None
+    try:
+        pixels = read_reference(path, "the study's reference", *dims)
+    except (OSError, ValueError):
+        return None
+    return pixels if is_reference(saved.get("reference"), path, pixels) else None
+
+
+def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[dict], dims, planned: dict,
+                    shading: str, pass_spp: int | None) -> dict:
+    """Every scene's :class:`ReferencePlan`, checked before any work.
+
+    A scene with rows keeps the reference they were measured against: a
+    given image must have its pixels, and ``--reference-spp`` its settings
+    (refused otherwise, before anything is written). A reference in DIR
+    whose pixels study.json names, made with this run's settings, is used as
+    it is; any other is rendered (resumed from its state) over it, which
+    loses nothing: rows measured against the old one were refused above."""
+    from .render.commands import _check_job_memory
+    from .render.image import EXR, check_output, read_reference
+    from .render.reference import reference_key, variance_path
+    from .render.render import plan
+    from .render.state import check_state_file, state_path
+
+    measured = {r["scene"] for r in rows}
+    plans = {}
+    for i, (name, scene) in enumerate(loaded.items()):
+        saved = settings["scenes"][name]
+        if args.reference:
+            path = Path(args.reference[i])
+            pixels = read_reference(path, "--reference", *dims)
+            if name in measured and not is_reference(saved.get("reference"), path, pixels):
+                raise ValueError(f"{out} holds {name} renders measured against {_made_with(saved)}, not {path}; "
+                                 "give that reference, or another --out")
+            plans[name] = ReferencePlan(path, pixels)
+            continue
+        path = out / f"reference-{name}.exr"
+        passes = args.reference_spp // pass_spp
+        made_with = dict(reference_spp=args.reference_spp, reference_passes=passes)
+        same = all(saved.get(k) == v for k, v in made_with.items())
+        if name in measured and not same:
+            raise ValueError(f"{out} holds {name} renders measured against {_made_with(saved)}, not one of "
+                             f"{_in_passes(args.reference_spp, passes)}; give the reference they used, or another "
+                             "--out")
+        state = state_path(path)
+        # a device or FIFO there would hang the read; refused now, not after the other scenes' references
+        check_state_file(state, "where pyoa study keeps its running sum")
+        if same and not state.exists():
+            pixels = _read_own(path, saved, dims)
+            if pixels is not None:
+                plans[name] = ReferencePlan(path, pixels, made_with=made_with)
+                continue
+        # a reference to render: every output it writes, checked now
+        check_output(path, "the study's reference", EXR)
+        check_output(variance_path(path), "the study's reference variance", EXR)
+        p = plan(scene, sampler="sobol", spp=pass_spp, seed=0, **planned)
+        _check_job_memory(p, f"a {name} reference pass of {pass_spp} spp")
+        key = reference_key(scene, p, pass_spp=pass_spp, passes=passes, seed=0, filter=args.filter, shading=shading)
+        plans[name] = ReferencePlan(path, None, key, made_with)
+    return plans
+
+
 def run(args) -> int:
     """``pyoa study`` (see the module docstring and ``pyoa study --help``)."""
     from .cluster import check_engine, engine, progress_over
     from .render.commands import _check_job_memory, _default_crop
-    from .render.image import EXR, check_crop, check_output, read_reference
-    from .render.reference import reference_key, render_reference
+    from .render.image import check_crop, read_reference
+    from .render.reference import render_reference
     from .render.render import plan, resolve_shading
     from .render.scene import load
     from .render.scene_source import source_of
     from .render.state import scene_digest
-    from .render.state import state_path as reference_state
 
     t_start = time.perf_counter()
     scenes_arg = list(dict.fromkeys(args.scenes))
@@ -493,6 +774,7 @@ def run(args) -> int:
     if args.reference and len(args.reference) != len(scenes_arg):
         raise ValueError(f"--reference gives {len(args.reference)} image(s) for {len(scenes_arg)} scene(s); give "
                          "one per scene, in the scenes' order")
+    pass_spp = None
     if args.reference_spp is not None:
         check_int("--reference-spp", args.reference_spp, 1)
         pass_spp = check_int("--pass-spp", min(args.pass_spp, args.reference_spp), 1, MAX_SPP)
@@ -500,121 +782,130 @@ def run(args) -> int:
             raise ValueError(f"--reference-spp ({args.reference_spp}) must be a multiple of --pass-spp ({pass_spp})")
     check_engine(args.workers, args.scheduler)
     out = check_out_dir(args.out)
-    shading = resolve_shading(args.shading)
-    size = dict(width=args.size[0], height=args.size[1]) if args.size else dict(width=None, height=None)
-    # plan() takes every render setting but the shading
-    planned = dict(**size, max_depth=args.max_depth, filter=args.filter, first=None, backend=args.backend)
-    common = dict(planned, shading=shading)
-    # every check a long job could fail at its end, on the client, before any task
-    loaded, jobs, refs = {}, [], {}
-    dims = None
-    for i, sname in enumerate(scenes_arg):
-        scene = load(sname)
-        if scene.name in loaded:
-            raise ValueError(f"two scenes named {scene.name!r}; a study tells scenes apart by name")
-        loaded[scene.name] = scene
-        for name in names:
-            for asked in spp_list:
-                n = catalogue.nearest_spp(name, asked)
-                if n is None:
-                    raise ValueError(f"{name} has no valid sample count near {asked}")
-                p = plan(scene, sampler=name, spp=n, seed=seed0, **planned)
-                _check_job_memory(p, f"a {scene.name} render with {name} at {n} spp")
-                dims = (p.width, p.height)
-                jobs += [Job(scene.name, name, asked, n, seed0 + k) for k in range(seeds)]
-        w, h = dims
-        if args.reference:
-            refs[scene.name] = Path(args.reference[i])
-            read_reference(refs[scene.name], "--reference", w, h)
-        else:
-            refs[scene.name] = out / f"reference-{scene.name}.exr"
-            check_output(refs[scene.name], "the study's reference", EXR)
-    crop = tuple(args.crop) if args.crop else _default_crop((dims[1], dims[0]))
-    check_crop(crop, *dims)
-    settings = dict(version=STUDY_VERSION, size=list(dims), crop=list(crop), max_depth=args.max_depth,
-                    filter=args.filter, shading=shading,
-                    scenes={n: dict(digest=scene_digest(s), reference=None) for n, s in loaded.items()})
-    settings = check_settings(out / "study.json", settings)
-    rows = read_rows(out / "study.csv")
-    for r in rows:
-        if r["scene"] in loaded and settings["scenes"][r["scene"]].get("reference") is None:
-            raise ValueError(f"{out / 'study.csv'} holds {r['scene']} rows but study.json no reference for "
-                             "them; give another --out")
-    with engine(args.workers, args.scheduler) as eng:
-        where = eng.description
-        # references first (resumable passes on the same engine)
-        images, noise = {}, {}
-        for name, scene in loaded.items():
-            path = refs[name]
-            if args.reference_spp is not None:
-                saved = settings["scenes"][name]
-                fresh = (path.is_file() and not reference_state(path).exists()
-                         and saved.get("reference") == file_digest(path)
-                         and saved.get("reference_spp") == args.reference_spp)
-                if not fresh:
-                    passes = args.reference_spp // pass_spp
-                    p = plan(scene, sampler="sobol", spp=pass_spp, seed=0, **planned)
-                    key = reference_key(scene, p, pass_spp=pass_spp, passes=passes, seed=0, filter=args.filter,
-                                        shading=shading)
-                    kwargs = dict(sampler="sobol", spp=pass_spp, **common)
+    with lock_study(out):
+        # the saved study first: a damaged study.json or study.csv is refused before the scenes are loaded
+        saved = load_settings(out / "study.json")
+        rows = read_rows(out / "study.csv")
+        shading = resolve_shading(args.shading)
+        size = dict(width=args.size[0], height=args.size[1]) if args.size else dict(width=None, height=None)
+        # plan() takes every render setting but the shading
+        planned = dict(**size, max_depth=args.max_depth, filter=args.filter, first=None, backend=args.backend)
+        common = dict(planned, shading=shading)
+        # every check a long job could fail at its end, on the client, before any task
+        loaded, jobs, dims = {}, [], None
+        for sname in scenes_arg:
+            scene = load(sname)
+            if scene.name in loaded:
+                raise ValueError(f"two scenes named {scene.name!r}; a study tells scenes apart by name")
+            loaded[scene.name] = scene
+            for name in names:
+                for asked in spp_list:
+                    n = catalogue.nearest_spp(name, asked)
+                    if n is None:
+                        raise ValueError(f"{name} has no valid sample count near {asked}")
+                    p = plan(scene, sampler=name, spp=n, seed=seed0, **planned)
+                    _check_job_memory(p, f"a {scene.name} render with {name} at {n} spp")
+                    if dims is None:
+                        dims, first = (p.width, p.height), scene.name
+                    elif (p.width, p.height) != dims:
+                        raise ValueError(f"{first} renders {dims[0]} x {dims[1]} and {scene.name} "
+                                         f"{p.width} x {p.height}; a study has one size: give --size W H")
+                    jobs += [Job(scene.name, name, asked, n, seed0 + k) for k in range(seeds)]
+        crop = tuple(args.crop) if args.crop else _default_crop((dims[1], dims[0]))
+        check_crop(crop, *dims)
+        settings = dict(version=STUDY_VERSION, size=list(dims), crop=list(crop), max_depth=args.max_depth,
+                        filter=args.filter, shading=shading,
+                        scenes={n: dict(digest=scene_digest(s)) for n, s in loaded.items()})
+        settings = check_settings(out, saved, settings)
+        for r in rows:
+            if r["scene"] in loaded and settings["scenes"][r["scene"]].get("reference") is None:
+                raise ValueError(f"{out / 'study.csv'} holds {r['scene']} rows but study.json no reference for "
+                                 "them; give another --out")
+        refs = plan_references(args, out, loaded, settings, rows, dims, planned, shading, pass_spp)
+        # the variance files of the references at hand (a given one's too)
+        noise = {n: _reference_noise(r.path, r.pixels, crop) for n, r in refs.items() if r.pixels is not None}
+        # every check made: now the rows the run appends to, as the catalogue spells them, once each
+        rows = read_rows(out / "study.csv", repair=True)
+        with engine(args.workers, args.scheduler) as eng:
+            where = eng.description
+            # references first (resumable passes on the same engine)
+            images = {}
+            for name, scene in loaded.items():
+                ref, rec = refs[name], settings["scenes"][name]
+                if ref.pixels is None:
+                    passes = ref.key["passes"]
                     if not args.quiet:
                         print(f"reference of {name}: {args.reference_spp} spp in {passes} passes on {where}")
-                    render_reference(eng, scene, out=path, key=key, kwargs=kwargs, seed=0, quiet=args.quiet,
-                                     command="pyoa study")
-                settings["scenes"][name]["reference_spp"] = args.reference_spp
-                settings["scenes"][name]["reference_passes"] = args.reference_spp // pass_spp
-            images[name] = read_reference(path, "--reference", *dims).astype(np.float64)
-            digest = file_digest(path)
-            old = settings["scenes"][name].get("reference")
-            if old is not None and old != digest and any(r["scene"] == name for r in rows):
-                raise ValueError(f"{out} holds {name} renders measured against another reference; give another "
-                                 "--out (or the reference they used)")
-            noise[name] = _reference_noise(path, images[name], crop)
-            shown = path.name if path.resolve().parent == out.resolve() else str(path)  # DIR's own: its name
-            settings["scenes"][name].update(reference=digest, reference_name=shown,
-                                            noise=list(noise[name]) if noise[name] else None)
+                    render_reference(eng, scene, out=ref.path, key=ref.key, kwargs=dict(common, sampler="sobol",
+                                     spp=pass_spp), seed=0, quiet=args.quiet, command="pyoa study")
+                    ref.pixels = read_reference(ref.path, "the study's reference", *dims)
+                    if any(r["scene"] == name for r in rows) and not is_reference(rec.get("reference"), ref.path,
+                                                                                   ref.pixels):
+                        # the settings of its rows' reference, rendered again with other pixels (another pyoa)
+                        raise ValueError(f"{out} holds {name} renders measured against another reference; give "
+                                         "another --out (or the reference they used)")
+                    noise[name] = _reference_noise(ref.path, ref.pixels, crop)
+                identity = pixel_identity(ref.pixels)
+                if ref.made_with is not None:
+                    rec.update(ref.made_with)
+                elif not is_reference(rec.get("reference"), ref.path, ref.pixels):
+                    rec.update(reference_spp=None, reference_passes=None)  # a given image, not one rendered here
+                images[name] = ref.pixels.astype(np.float64)
+                shown = ref.path.name if ref.path.resolve().parent == out.resolve() else str(ref.path)  # DIR's own
+                rec.update(reference=identity, reference_name=shown,
+                           noise=list(noise[name]) if noise[name] else None)
+            write_settings(out / "study.json", settings)
+            done = {ident(r) for r in rows}
+            todo = [j for j in jobs if j.ident not in done]
+            if not args.quiet:
+                print(f"study: {len(jobs)} renders, {len(jobs) - len(todo)} already in {out / 'study.csv'}, "
+                      f"{len(todo)} to render on {where}")
+            shared = {n: (eng.share(s if eng.client is None else source_of(s)), eng.share(images[n]))
+                      for n, s in loaded.items()}
+            threads = eng.task_threads()
+            kwargs = dict(common)
+            args_list = [(*shared[j.scene], crop, kwargs, j, threads) for j in todo]
+            writer = RowWriter(out / "study.csv")
+            try:
+                with closing(eng.run(study_task, args_list, key="pyoa-study")) as results:
+                    for _, row in progress_over(results, len(todo), "study", args.quiet, unit="render"):
+                        writer.add(row)
+                        rows.append(row)
+            finally:
+                writer.close()
+        seconds = time.perf_counter() - t_start
+        # what each run (the first and every resumption) rendered, where, and how long it took
+        settings["runs"] = [*settings.get("runs", []), dict(seconds=round(seconds, 1), where=where,
+                                                            rendered=len(todo),
+                                                            date=time.strftime("%Y-%m-%dT%H:%M:%S"))]
         write_settings(out / "study.json", settings)
-        done = {(r["scene"], r["sampler"], r["spp_asked"], r["seed"]) for r in rows}
-        todo = [j for j in jobs if j.ident not in done]
-        if not args.quiet:
-            print(f"study: {len(jobs)} renders, {len(jobs) - len(todo)} already in {out / 'study.csv'}, "
-                  f"{len(todo)} to render on {where}")
-        shared = {n: (eng.share(s if eng.client is None else source_of(s)), eng.share(images[n]))
-                  for n, s in loaded.items()}
-        threads = eng.task_threads()
-        kwargs = dict(common)
-        args_list = [(*shared[j.scene], crop, kwargs, j, threads) for j in todo]
-        writer = RowWriter(out / "study.csv")
-        try:
-            with closing(eng.run(study_task, args_list, key="pyoa-study")) as results:
-                for _, row in progress_over(results, len(todo), "study", args.quiet, unit="render"):
-                    writer.add(row)
-                    rows.append(row)
-        finally:
-            writer.close()
-    seconds = time.perf_counter() - t_start
-    # what each run (the first and every resumption) rendered, where, and how long it took
-    settings.setdefault("runs", []).append(dict(seconds=round(seconds, 1), where=where, rendered=len(todo),
-                                                date=time.strftime("%Y-%m-%dT%H:%M:%S")))
-    write_settings(out / "study.json", settings)
-    wanted = {j.ident for j in jobs}
-    mine = [r for r in rows if (r["scene"], r["sampler"], r["spp_asked"], r["seed"]) in wanted]
-    # the report follows the command's order of scenes and samplers, not the order rows were rendered in
-    # (a resumed study appends the rows it renders after the ones it found)
-    place = {(s, n): k for k, (s, n) in enumerate((s, n) for s in loaded for n in names)}
-    mine.sort(key=lambda r: (place.get((r["scene"], r["sampler"]), len(place)), r["spp_asked"], r["seed"]))
-    md = report(settings, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in settings["runs"]),
-                where=where)
-    with atomic_path(out / "study.md") as tmp:
-        tmp.write_text(md)
-    table = cells(mine, noise)
-    plot(out / "study.png", table, list(loaded), names)
-    for name in loaded:
-        plot(out / f"study-{name}.png", table, [name], names)
+        wanted = {j.ident for j in jobs}
+        mine = [r for r in rows if ident(r) in wanted]
+        # the report follows the command's order of scenes and samplers, not the order rows were rendered in
+        # (a resumed study appends the rows it renders after the ones it found)
+        place = {(s, n): k for k, (s, n) in enumerate((s, n) for s in loaded for n in names)}
+        mine.sort(key=lambda r: (place.get((r["scene"], r["sampler"]), len(place)), r["spp_asked"], r["seed"]))
+        md = report(settings, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in settings["runs"]),
+                    where=where)
+        with atomic_path(out / "study.md") as tmp:
+            tmp.write_text(md)
+        table = cells(mine, noise)
+        plot(out / "study.png", table, list(loaded), names)
+        for name in loaded:
+            plot(out / f"study-{name}.png", table, [name], names)
     if not args.quiet:
         print(md)
         print(f"-> {out / 'study.md'}, {out / 'study.csv'}, {out / 'study.png'} ({seconds:.0f} s)")
     return 0
+
+
+def interrupted(args) -> str:
+    """What an interrupted study leaves (``pyoa.cli`` prints it): the rows
+    and reference passes already in DIR, which a rerun continues from."""
+    out = Path(args.out)
+    if (out / "study.csv").is_file() or any(out.glob("*.state.npz")):
+        return f"the finished renders are kept in {out} (run the same command again to continue)"
+    return "no render finished"
 
 
 def add_parser(sub) -> None:
@@ -650,4 +941,4 @@ def add_parser(sub) -> None:
                                                                "(and the references)")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing (the report is in DIR/study.md)")
     add_arguments(p)
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, interrupted=interrupted)
