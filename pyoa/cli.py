@@ -27,7 +27,7 @@ from .backends import BackendUnavailable, PyoaFallbackWarning
 from .catalogue import get
 from .catalogue_types import MAX_UINT32, SppChoice, check_int
 from .cluster import TasksLost
-from .samplers import trial_options
+from .samplers import ENV_MAX_BYTES, trial_options
 from .units import format_rate
 
 FORMATS = (".npy", ".csv")
@@ -198,8 +198,9 @@ def cmd_spectrum(args) -> int:
 def cmd_backends(args) -> int:
     from .hostcpu import host_cpu
 
+    report = backends()  # first: a bad $PYOA_BACKEND is refused before anything is printed
     print(f"CPU: {host_cpu().describe()}")
-    for b in backends():
+    for b in report:
         mark = "*" if b["default"] else " "
         state = b["device"] if b["usable"] else f"not usable: {b['reason']}"
         print(f"{mark} {b['name']:7s} {state}")
@@ -314,6 +315,21 @@ def main(argv: list[str] | None = None) -> int:
         # OSError: an output that cannot be written (pyoa.atomic names the
         # user's path), a missing input file; a one-line message, not a traceback
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
+    except MemoryError as exc:
+        # the memory plans refuse a job over $PYOA_MAX_BYTES before it starts, but they are estimates, and
+        # the process may be allowed less than the limit (ulimit -v, a container)
+        first = (str(exc).strip().splitlines() or [""])[0]
+        ap.exit(2, f"pyoa {args.command}: error: out of memory{f' ({first})' if first else ''}: this job needs more "
+                   "memory than the process may use; render a smaller scene, image or sample count, or set "
+                   f"${ENV_MAX_BYTES} to the memory available so that such a job is refused before it "
+                   "starts\n")
+    except KeyboardInterrupt:
+        # Ctrl-C, or SIGINT from a job manager: every output is written atomically (pyoa.atomic), so none is
+        # left half-written; a command's ``interrupted(args)`` says what it kept. 130 = 128 + SIGINT, as a shell
+        # reports a process that SIGINT ended.
+        kept = getattr(args, "interrupted", None)
+        note = kept(args) if kept else "no output is left half-written (each is replaced only by a complete one)"
+        ap.exit(130, f"pyoa {args.command}: interrupted; {note}\n")
 
 
 if __name__ == "__main__":

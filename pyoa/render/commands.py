@@ -31,6 +31,7 @@ from .progressive import check_progressive, render_progressive, state_path
 from .reference import reference_key, render_reference, variance_path
 from .render import SHADINGS, check_memory, plan, resolve_shading
 from .scene import load
+from .state import check_state_file
 from .tiles import render_on
 
 #: Bytes per pixel that a command allocates besides the render, bounded: the
@@ -88,6 +89,8 @@ def cmd_render(args) -> int:
     check_output(args.out, "--out", EXR)
     if args.png:
         check_output(args.png, "--png", PNG)
+    if args.progressive:
+        check_state_file(state_path(args.out), "where a progressive render keeps its running sum")
     check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.spp, base=args.base)
@@ -255,10 +258,7 @@ def cmd_reference(args) -> int:
     check_int("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
     check_output(args.out, "--out", EXR)
     check_output(variance_path(args.out), "--out (its variance)", EXR)
-    state = state_path(args.out)
-    if state.is_dir():
-        raise ValueError(f"{str(state)!r} (where pyoa reference keeps its running sum) is a directory; "
-                         "remove or rename it")
+    check_state_file(state_path(args.out), "where pyoa reference keeps its running sum")
     check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.pass_spp)
@@ -279,6 +279,23 @@ def cmd_reference(args) -> int:
             print(f"its own noise: relMSE {relmse_noise(var, ref):.3g} (per-pixel variance of the mean -> "
                   f"{variance_path(args.out)})")
     return 0
+
+
+def render_interrupted(args) -> str:
+    """What an interrupted ``pyoa render`` leaves (``pyoa.cli`` prints it):
+    a progressive render's last complete doubling, else nothing."""
+    state = state_path(args.out)
+    if args.progressive and state.is_file():
+        return f"{args.out} and {state} hold the last complete doubling (continue with --resume)"
+    return "nothing written (the image is written once it is complete)"
+
+
+def reference_interrupted(args) -> str:
+    """What an interrupted ``pyoa reference`` leaves (``pyoa.cli`` prints it): its finished passes."""
+    state = state_path(args.out)
+    if state.is_file():
+        return f"the finished passes are kept in {state} (run the same command again to resume)"
+    return "nothing written"
 
 
 def add_parsers(sub) -> None:
@@ -320,7 +337,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--reference", default=None, help="reference EXR: print the relative MSE")
     p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
                    help="also the relative MSE of this window")
-    p.set_defaults(func=cmd_render)
+    p.set_defaults(func=cmd_render, interrupted=render_interrupted)
 
     p = sub.add_parser("compare", help="render with several samplers and tabulate relMSE against a reference")
     common(p, 121)
@@ -337,4 +354,4 @@ def add_parsers(sub) -> None:
     p.add_argument("--sampler", default="sobol", help="sampler of each pass (default sobol)")
     p.add_argument("--pass-spp", type=int, default=256, help="samples per pass (default 256)")
     p.add_argument("--out", default="reference.exr", help="EXR output (default reference.exr)")
-    p.set_defaults(func=cmd_reference)
+    p.set_defaults(func=cmd_reference, interrupted=reference_interrupted)

@@ -51,6 +51,9 @@ _GEOMETRY_TYPE_TRIANGLE = 0
 _BUFFER_TYPE_INDEX, _BUFFER_TYPE_VERTEX = 0, 1
 _FORMAT_UINT3, _FORMAT_FLOAT3 = 0x5003, 0x9003
 _SCENE_FLAG_ROBUST = 1 << 2
+#: RTCError of an allocation that failed: a MemoryError, not a missing Embree
+#: (which would fall back to the NumPy shading, whose embreex crashes then).
+_ERROR_OUT_OF_MEMORY = 4
 
 
 class EmbreeUnavailable(RuntimeError):
@@ -152,8 +155,9 @@ class Scene:
             vb = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3, 12, 3 * len(tris))
             ib = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3, 12, len(tris))
             if not vb or not ib:
-                raise EmbreeUnavailable(f"Embree could not allocate the scene's buffers "
-                                        f"(error {lib.rtcGetDeviceError(self._device)})")
+                err = lib.rtcGetDeviceError(self._device)
+                kind = MemoryError if err == _ERROR_OUT_OF_MEMORY else EmbreeUnavailable
+                raise kind(f"Embree could not allocate the buffers of {len(tris)} triangles (error {err})")
             # Embree owns these buffers (and pads the vertex buffer as it needs).
             ctypes.memmove(vb, tris.ctypes.data, tris.nbytes)
             idx = np.arange(3 * len(tris), dtype=np.uint32)
@@ -164,7 +168,8 @@ class Scene:
             lib.rtcCommitScene(self._scene)
             err = lib.rtcGetDeviceError(self._device)
             if err:
-                raise EmbreeUnavailable(f"Embree could not build the scene (error {err})")
+                kind = MemoryError if err == _ERROR_OUT_OF_MEMORY else EmbreeUnavailable
+                raise kind(f"Embree could not build the scene of {len(tris)} triangles (error {err})")
         except BaseException:
             self.close()
             raise

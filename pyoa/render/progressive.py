@@ -33,8 +33,11 @@ images would be worse than random ones, and it is refused.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -46,6 +49,8 @@ from .integrator import Stats
 from .render import plan, render, resolve_shading
 from .state import (
     BadState,
+    check_state_file,
+    describe_size,
     read_state,
     saved_key,
     scene_digest,
@@ -57,7 +62,7 @@ from .state import (
 STATE_VERSION = 1
 #: Settings of the key, and how the user sets them (for the refusal to resume).
 _KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
-               "width": "--size W", "height": "--size H", "max_depth": "--max-depth", "sampler": "--sampler",
+               "width": "--size", "height": "--size", "max_depth": "--max-depth", "sampler": "--sampler",
                "base": "--base", "seed": "--seed", "filter": "--filter", "first": "--first",
                "shading": "--shading", "spp": "--spp"}
 
@@ -98,11 +103,35 @@ def _describe_change(saved: dict, key: dict) -> str:
         if saved.get(fld) != key.get(fld):
             if fld in ("scene", "first", "version"):
                 return f"it was made with {option}"
+            if fld in ("width", "height"):
+                return describe_size(saved, key)
             if fld == "spp":
                 return (f"it was made with --spp {saved.get('spp')}, and {key['sampler']}'s samples depend on "
                         f"--spp (continue it at --spp {saved.get('spp')})")
             return f"it was made with {option} {saved.get(fld)}, not {key.get(fld)}"
     return "it was made with other settings"  # pragma: no cover - keys differ in a field not listed
+
+
+@contextlib.contextmanager
+def _held_interrupt():
+    """Hold a SIGINT (Ctrl-C) that arrives in the block until it ends, then
+    raise KeyboardInterrupt: the files written in it then hold the same
+    doubling (each file is written atomically, but an interrupt between two
+    would leave the image one doubling ahead of the state). Only in the main
+    thread with Python's default handler: elsewhere a handler cannot be set,
+    or another one is in charge."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield
+        return
+    held = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if held:
+        raise KeyboardInterrupt
 
 
 @dataclass
@@ -150,7 +179,9 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
         Continue from ``OUT.state.npz``. A state of other settings is
         refused (ValueError saying which); without a state the render
         starts from the first sample. Without ``resume`` an existing state
-        is replaced once the first block is done.
+        is replaced once the first block is done. A state path that is not a
+        regular file (a device, a FIFO, a directory, or a symlink to one) is
+        refused either way (:func:`.state.check_state_file`).
     quiet : bool
         No progress output.
 
@@ -169,9 +200,7 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
         if not (math.isfinite(time_budget) and time_budget > 0):
             raise ValueError(f"time_budget must be a positive number of seconds, got {time_budget}")
     state = state_path(out)
-    if state.is_dir():
-        raise ValueError(f"{str(state)!r} (where a progressive render keeps its running sum) is a directory; "
-                         "remove or rename it")
+    check_state_file(state, "where a progressive render keeps its running sum")
     entry = catalogue.get(sampler)
     saved = saved_key(state) if resume and state.exists() else None
     if base is None and saved and saved.get("sampler") == entry.name and saved.get("base") is not None:
@@ -223,10 +252,11 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
         total += block
         done = end
         image = (total / done).astype(np.float32)
-        write_exr(out, image)
-        if png:
-            write_png(png, image)
-        write_state(state, total, "samples", done, key)
+        with _held_interrupt():  # Ctrl-C waits until the image, the PNG and the state hold this doubling
+            write_exr(out, image)
+            if png:
+                write_png(png, image)
+            write_state(state, total, "samples", done, key)
         result.stats.add(res.stats)
         result.written.append(done)
         result.image, result.samples = image, done

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .image import check_finite, write_exr
-from .state import BadState, read_state_arrays, scene_digest, state_path, write_state
+from .state import BadState, check_state_file, describe_size, read_state_arrays, scene_digest, state_path, write_state
 from .tiles import worker_render
 
 #: Key of the reference passes' seeds (see pass_seed).
@@ -38,7 +38,7 @@ REFERENCE_KEY = 0x52454631
 STATE_VERSION = 3
 #: Options named when a state's key differs from this run's (key field -> how to say it).
 _KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
-               "width": "--size W", "height": "--size H", "max_depth": "--max-depth", "sampler": "--sampler",
+               "width": "--size", "height": "--size", "max_depth": "--max-depth", "sampler": "--sampler",
                "pass_spp": "--pass-spp", "passes": "--spp", "seed": "--seed", "filter": "--filter",
                "first": "--first", "shading": "--shading"}
 
@@ -82,6 +82,8 @@ def describe_change(saved: dict, key: dict) -> str:
         if saved.get(field) != key[field]:
             if field in ("scene", "first", "version"):
                 return f"made with {option}"
+            if field in ("width", "height"):
+                return describe_size(saved, key)
             if field == "passes":  # say it as the user gave it: --spp, the total
                 return f"made with --spp {_total_spp(saved)}, not {_total_spp(key)}"
             return f"made with {option} {saved.get(field)}, not {key[field]}"
@@ -94,6 +96,10 @@ class Passes:
     ``add(k, image)`` takes pass k's float32 image in any order; the sums
     take the passes in order 0, 1, 2, ... (a pass that arrives early is kept,
     and saved, until the ones before it have arrived).
+
+    A state of another run, or one that holds no valid sums, is not resumed
+    (a one-line note says why, on stderr); a state path that is not a
+    regular file is refused (:func:`.state.check_state_file`, a ValueError).
     """
 
     def __init__(self, state: Path, key: dict, *, quiet: bool = False, command: str = "pyoa reference"):
@@ -101,6 +107,7 @@ class Passes:
         self.shape = (key["height"], key["width"], 3)
         self.total = self.sumsq = None
         self.done, self.pending = 0, {}
+        check_state_file(self.state, f"where {command} keeps its running sum")
         if self.state.exists():
             try:
                 sums, self.done, self.pending = read_state_arrays(self.state, key, "passes", self.passes,

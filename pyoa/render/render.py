@@ -40,6 +40,14 @@ PIXEL_BYTES = 12
 BATCH_BYTES = 128
 #: Most pixels in one image: pixel indices are uint32 (the sampler's pixel seeds).
 MAX_PIXELS = MAX_UINT32 + 1
+#: Memory of a loaded scene per triangle while it is traced: its own arrays
+#: (100 bytes: float32 vertices, float64 normals, areas and emission, ids)
+#: and, at the peak of building them, the tracer's float64 copies and
+#: Embree's buffers and BVH: 202 to 297 bytes more. Measured as VmHWM above
+#: the process before the render (after the load's garbage was freed), for
+#: 1M-triangle meshes with numba and NumPy shading; 512 with a margin. (The
+#: load's own peak is pyoa.render.scene.MESH_TRIANGLE_BYTES.)
+SCENE_TRIANGLE_BYTES = 512
 #: Shading implementations: numba-compiled with Embree called from it (the
 #: default), or the NumPy reference.
 SHADINGS = ("numba", "numpy")
@@ -124,12 +132,17 @@ def render_bytes(width: int, height: int, spp: int, dims: int, *, batch_paths: i
     return n_pixels * PIXEL_BYTES + n_batches * BATCH_BYTES + in_flight
 
 
-def check_memory(nbytes: int, what: str, limit: int) -> None:
+def check_memory(nbytes: int, what: str, limit: int, fix: str = "render fewer pixels or samples") -> None:
     """Refuse (ValueError) a job that needs more than ``limit`` bytes, before
-    anything is allocated."""
+    anything is allocated; ``fix`` says how to need less."""
     if nbytes > limit:
         raise ValueError(f"{what} needs {format_bytes(nbytes)}, over the memory limit of {format_bytes(limit)}; "
-                         f"render fewer pixels or samples, or raise the limit with max_bytes= or ${ENV_MAX_BYTES}")
+                         f"{fix}, or raise the limit with max_bytes= or ${ENV_MAX_BYTES}")
+
+
+def scene_bytes(scene) -> int:
+    """Bytes a loaded scene takes while it is traced (``SCENE_TRIANGLE_BYTES`` per triangle)."""
+    return len(scene.triangles) * SCENE_TRIANGLE_BYTES
 
 
 def image_size(scene, width: int | None = None, height: int | None = None,
@@ -156,7 +169,7 @@ class Plan:
     height: int
     layout: Layout
     sampler: object  # pyoa.samplers.Sampler
-    nbytes: int
+    nbytes: int  # the render's peak with the scene's tracer (render_bytes + scene_bytes)
     max_bytes: int
 
 
@@ -183,8 +196,12 @@ def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: 
     image = {"resolution": (width, height)} if catalogue.get(sampler).needs_resolution else {}
     smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend, max_bytes=limit,
                        base=base, **image)
-    nbytes = render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
-    check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit)
+    # the scene's tracer (Embree's BVH) counts too: it is built before the first sample
+    traced = scene_bytes(scene)
+    nbytes = traced + render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
+    fix = (f"render a scene of fewer triangles (its {len(scene.triangles)} triangles take {format_bytes(traced)} "
+           "to trace)" if 2 * traced > nbytes else "render fewer pixels or samples")
+    check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit, fix)
     return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit)
 
 
@@ -256,9 +273,10 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         Both estimate the same image; each gives the same bits for any batch
         size and thread count.
     max_bytes : int or str, optional
-        Memory limit (default ``$PYOA_MAX_BYTES``, else half of the RAM, as
-        the samplers'): a render that would need more (:func:`render_bytes`)
-        is refused with a ValueError before anything is allocated.
+        Memory limit (default ``$PYOA_MAX_BYTES``, else half of the memory the process may use, as
+        the samplers'): a render that would need more (:func:`render_bytes`,
+        and :func:`scene_bytes` for the scene's tracer) is refused with a
+        ValueError before anything is allocated.
     base : int, optional
         The digit base of ``faure`` (refused by the other samplers).
     samples : range, optional

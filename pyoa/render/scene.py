@@ -43,6 +43,11 @@ Conventions are Mitsuba's:
   rough conductor: ``specular`` colour, default white, and ``roughness``, the
   GGX alpha as Mitsuba's ``alpha``, in (0, 1], default 0.1) and ``mirror``
   (``tint``, default white). Colours are RGB in [0, 1].
+* Embree traces in float32, so the scene must be one float32 resolves
+  (:func:`_check_float32_precision`): its largest coordinate (vertices and
+  camera) at most ``MAX_POSITION_RATIO`` = 2^15 times its extent (the scene
+  spans at least 256 float32 steps), and its extent at most ``MAX_EXTENT`` =
+  1e12 (the products of Embree's ray-triangle test stay within float32).
 
 Every error found on load is a :class:`ValueError` whose message names the
 file and the field (``cornell.json: shapes[3].material: unknown material
@@ -159,6 +164,13 @@ def cube() -> np.ndarray:
 
 #: Largest value a float32 image holds (emission, world coordinates).
 FLOAT32_MAX = float(np.finfo(np.float32).max)
+#: A scene's largest coordinate may be at most this many times its extent:
+#: float32 numbers near a coordinate C are up to 2^-23 C apart, so the scene
+#: spans at least 2^23 / 2^15 = 256 float32 steps (see _check_float32_precision).
+MAX_POSITION_RATIO = 2.0**15
+#: Largest extent of a scene (the longest side of the bounding box of its
+#: vertices and camera); see _check_float32_precision.
+MAX_EXTENT = 1e12
 #: Longest integer literal read from a scene file (Python's own limit on
 #: int-from-string conversion is 4300 digits; no field needs more than a few).
 MAX_INT_DIGITS = 100
@@ -294,6 +306,63 @@ def _transform(tris: np.ndarray, m: np.ndarray) -> np.ndarray:
     return out
 
 
+def _check_float32_precision(ctx: _Ctx, bounds, camera: Camera, shapes) -> None:
+    """Refuse (:class:`SceneError`) a scene that Embree's float32 ray tracing
+    cannot resolve. Both rules look at the axis-aligned box around the
+    vertices (``bounds``: ``(index, low corner, high corner)`` of each shape
+    in world space) and the camera (its positions when the shutter opens and
+    closes, widened by the lens radius); the extent ``E`` is the box's
+    longest side, ``C`` the largest coordinate magnitude in it.
+
+    * ``C <= MAX_POSITION_RATIO * E`` (2^15 E): float32 numbers near ``C``
+      are up to ``2^-23 C`` apart, so the scene spans at least 256 float32
+      steps. Beyond, storing the vertices as float32 moves them by a visible
+      part of the scene (the cornell box translated by 1e5 along x, ``C / E``
+      = 2e4, loses 1.5 % of its light's width and 0.9 % of the image mean; at
+      1e13 float32 steps are 2e5 times the box). A scene far from the origin
+      must be moved near it.
+    * ``E <= MAX_EXTENT`` (1e12): Embree's ray-triangle test multiplies three
+      coordinate differences (each up to the box's diagonal, ``sqrt(3) E``);
+      beyond about 1e12 the products near float32's largest value, 3.4e38,
+      and rays miss (the cornell box scaled by 3e12 loses 22 % of the image
+      mean, by 1e13 99 %). Such a scene must be scaled down, or its camera
+      brought closer.
+
+    Scaling alone keeps ``C / E``, and the renderer's ray offsets follow the
+    size of the geometry (``pyoa.render.integrator.offset_distance``), so a
+    scene renders the same at every scale between these limits.
+    """
+    pos = camera.to_world[:3, 3]
+    cam = np.stack([pos, pos + camera.motion])
+    cam = np.concatenate([cam - camera.aperture, cam + camera.aperture])
+    lows = np.array([b[1] for b in bounds])
+    highs = np.array([b[2] for b in bounds])
+    lo = np.minimum(lows.min(axis=0), cam.min(axis=0))
+    hi = np.maximum(highs.max(axis=0), cam.max(axis=0))
+    extent = float((hi - lo).max())
+    if extent > MAX_EXTENT:
+        raise ctx.error("", f"the scene is {extent:.3g} across (vertices and camera), over the {MAX_EXTENT:.0e} "
+                            f"that Embree's float32 ray tracing handles: its ray-triangle test multiplies three "
+                            f"coordinate differences, which overflow float32 (3.4e38), and rays miss; "
+                            f"scale the scene down or bring the camera closer")
+    per_shape = np.maximum(np.abs(lows), np.abs(highs)).max(axis=1)
+    k = int(per_shape.argmax())
+    largest_cam = float(np.abs(cam).max())
+    largest = max(float(per_shape[k]), largest_cam)
+    if largest > MAX_POSITION_RATIO * extent:
+        if largest_cam >= per_shape[k]:
+            where = "camera"
+        else:
+            i = bounds[k][0]
+            where = f"shapes[{i}].to_world" if "to_world" in shapes[i] else f"shapes[{i}].file"
+        spacing = float(np.spacing(np.float32(largest)))
+        raise ctx.error(where, f"coordinates up to {largest:.3g} with an extent of {extent:.3g} (vertices and "
+                               f"camera): float32, which Embree traces in, is {spacing:.3g} apart there, "
+                               f"{spacing / extent:.3g} times the scene's extent; a scene must span at least "
+                               f"{2.0**23 / MAX_POSITION_RATIO:.0f} float32 steps (coordinates at most "
+                               f"{MAX_POSITION_RATIO:.0f} times its extent): move the scene near the origin")
+
+
 # -- loading -------------------------------------------------------------------------
 
 _TOP = ("description", "camera", "film", "integrator", "materials", "shapes")
@@ -392,21 +461,59 @@ def _materials(ctx: _Ctx, v) -> tuple[Materials, dict[str, int]]:
     return Materials.build(specs), ids
 
 
-def _mesh(ctx: _Ctx, where: str, file, base: Path) -> np.ndarray:
+#: Peak memory of trimesh's parse of a mesh file, per byte of the file:
+#: measured (VmHWM above the process before it, 1M-triangle meshes, trimesh
+#: 5.2) 6.7 (OBJ), 8.0 (GLB), 9.6 (binary STL) and 10.6 (binary PLY); 12
+#: with a margin. Checked before the file is parsed.
+MESH_FILE_FACTOR = 12
+#: Peak memory of loading a mesh, per triangle: trimesh's arrays, the float64
+#: world-space copies made here and the scene's own arrays. Measured the same
+#: way: 440 bytes (GLB), 443 (OBJ), 497 (binary PLY) and 718 (binary STL,
+#: which repeats every vertex); 1 KiB with a margin. Checked once the file
+#: is parsed, before the copies are made, for all of a scene's meshes
+#: together (a scene of many meshes is overestimated: only the last is
+#: being copied at the peak).
+MESH_TRIANGLE_BYTES = 1024
+
+
+class _MeshMemory:
+    """The memory limit of a scene's meshes and the triangles loaded so far."""
+
+    def __init__(self, limit: int):
+        self.limit, self.triangles = limit, 0
+
+    def check(self, ctx: _Ctx, where: str, nbytes: int, what: str) -> None:
+        from .render import check_memory
+
+        try:
+            check_memory(nbytes, what, self.limit, "use a mesh of fewer triangles")
+        except ValueError as e:
+            raise ctx.error(where, str(e)) from None
+
+
+def _mesh(ctx: _Ctx, where: str, file, base: Path, memory: _MeshMemory) -> np.ndarray:
     import trimesh
 
     rel = _string(ctx, where, file)
     path = (base / rel).resolve()
     if not path.is_file():
         raise FileNotFoundError(f"{ctx.filename}: {where}: mesh file not found: {path}")
+    size = path.stat().st_size
+    memory.check(ctx, where, size * MESH_FILE_FACTOR, f"parsing mesh {rel!r} ({size} bytes)")
     try:
         mesh = trimesh.load(str(path), force="mesh", process=False)
+    except MemoryError:
+        raise  # not a bad file: pyoa's command line says so in one line
     except Exception as e:  # noqa: BLE001 - trimesh raises anything from a bad file
         raise ctx.error(where, f"trimesh cannot load {rel!r}: {type(e).__name__}: {e}") from None
     faces = getattr(mesh, "faces", None)
     vertices = getattr(mesh, "vertices", None)
     if faces is None or vertices is None or len(faces) == 0:
         raise ctx.error(where, f"mesh {rel!r} has no triangles")
+    memory.triangles += len(faces)
+    also = f" ({memory.triangles} with the meshes before it)" if memory.triangles > len(faces) else ""
+    memory.check(ctx, where, memory.triangles * MESH_TRIANGLE_BYTES,
+                 f"loading mesh {rel!r} of {len(faces)} triangles{also}")
     tris = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
     if tris.ndim != 3 or tris.shape[1:] != (3, 3) or not np.isfinite(tris).all():
         raise ctx.error(where, f"mesh {rel!r} has invalid vertex data")
@@ -419,11 +526,12 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path):
+def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path, camera: Camera, memory: _MeshMemory):
     if not isinstance(v, list):
         raise ctx.error("shapes", f"expected a list of shapes, got {_show(v)}")
     if not v:
         raise ctx.error("shapes", "no shapes")
+    shapes = []  # (index, shape, world, material id, emission), checked for precision before degeneracy
     tris, mats, ems, owner = [], [], [], []
     valid_mats = ", ".join(ids)
     for i, s in enumerate(v):
@@ -437,7 +545,7 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path):
         if t == "mesh":
             if "file" not in s:
                 raise ctx.error(f"{where}.file", "missing (required for a mesh)")
-            local = _mesh(ctx, f"{where}.file", s["file"], base)
+            local = _mesh(ctx, f"{where}.file", s["file"], base, memory)
         elif "file" in s:
             raise ctx.error(f"{where}.file", f"only a mesh has a file, not a {t}")
         else:
@@ -456,6 +564,14 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path):
         if not np.all(np.abs(world) <= FLOAT32_MAX):  # triangles are stored (and traced) as float32
             field_ = f"{where}.to_world" if "to_world" in s else f"{where}.file"
             raise ctx.error(field_, f"vertices beyond the float32 range (|x| <= {FLOAT32_MAX:.4g}) in world space")
+        shapes.append((i, s, world, ids[name], emission))
+    # before the degeneracy test below, whose area threshold grows with the
+    # coordinates: a scene far from the origin is refused as far, not as flat
+    _check_float32_precision(ctx, [(i, w.min(axis=(0, 1)), w.max(axis=(0, 1))) for i, _s, w, _m, _e in shapes],
+                             camera, v)
+    for j, (i, s, world, mat, emission) in enumerate(shapes):
+        shapes[j] = None  # a mesh's unfiltered copy goes once world[keep] replaces it
+        where, t = f"shapes[{i}]", s["type"]
         cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
         area2 = np.linalg.norm(cross, axis=1)
         keep = area2 > 1e-12 * max(1.0, float(np.abs(world).max())) ** 2
@@ -466,13 +582,13 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path):
         elif not keep.all():  # cannot happen with an invertible to_world
             raise ctx.error(f"{where}.to_world", "the transform makes triangles degenerate")
         tris.append(world)
-        mats.append(np.full(len(world), ids[name], dtype=np.int32))
+        mats.append(np.full(len(world), mat, dtype=np.int32))
         ems.append(np.tile(emission, (len(world), 1)))
         owner.append(np.full(len(world), i, dtype=np.int32))
     return np.concatenate(tris), np.concatenate(mats), np.concatenate(ems), np.concatenate(owner)
 
 
-def _load_file(path: Path) -> Scene:
+def _load_file(path: Path, max_bytes: int) -> Scene:
     ctx = _Ctx(path.name)
     if not path.is_file():
         raise FileNotFoundError(f"{path.name}: scene file not found: {path}")
@@ -489,7 +605,8 @@ def _load_file(path: Path) -> Scene:
     max_depth = _integer(ctx, "integrator.max_depth", integ.get("max_depth", 5), 1, MAX_DEPTH)
     mis = _boolean(ctx, "integrator.mis", integ.get("mis", True))
     materials, ids = _materials(ctx, data["materials"])
-    world, material, emission, owner = _shapes(ctx, data["shapes"], ids, path.parent)
+    memory = _MeshMemory(max_bytes)
+    world, material, emission, owner = _shapes(ctx, data["shapes"], ids, path.parent, camera, memory)
     if not (emission.max(axis=1) > 0).any():
         raise ctx.error("shapes", "no shape has a nonzero emission: nothing would be lit")
     cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
@@ -523,17 +640,26 @@ def bundled() -> dict[str, str]:
     return dict(sorted(out.items()))
 
 
-def load(scene: str | os.PathLike) -> Scene:
+def load(scene: str | os.PathLike, max_bytes: int | str | None = None) -> Scene:
     """Load a scene: a path to a ``.json`` file, or the name of a bundled
-    scene (``"cornell"``, see :func:`bundled`)."""
+    scene (``"cornell"``, see :func:`bundled`).
+
+    Its meshes must load within the memory limit ``max_bytes`` (default
+    ``$PYOA_MAX_BYTES``, else half the usable memory: :func:`pyoa.render.render.resolve_max_bytes`):
+    a mesh file is refused before it is parsed if its size, and once parsed
+    if the scene's triangles so far, need more (``MESH_FILE_FACTOR`` per
+    byte, ``MESH_TRIANGLE_BYTES`` per triangle); a :class:`SceneError`."""
+    from .render import resolve_max_bytes
+
+    limit = resolve_max_bytes(max_bytes)
     if isinstance(scene, os.PathLike):
-        return _load_file(Path(scene))
+        return _load_file(Path(scene), limit)
     if not isinstance(scene, str):
         raise TypeError(f"scene must be a path or a bundled scene name, got {type(scene).__name__}")
     p = Path(scene)
     if p.is_file() or scene.endswith(".json") or os.sep in scene or "/" in scene:
-        return _load_file(p)
+        return _load_file(p, limit)
     names = bundled()
     if scene not in names:
         raise UnknownSceneError(f"{scene}: no such scene file or bundled scene; bundled: {', '.join(names)}")
-    return _load_file(Path(names[scene]))
+    return _load_file(Path(names[scene]), limit)
