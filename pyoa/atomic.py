@@ -20,6 +20,13 @@ def _umask() -> int:
     return mask
 
 
+def new_file_mode() -> int:
+    """The mode a plain :func:`open` gives a new file: ``0o666`` less the
+    umask (so a group-shared directory, umask 002, gets group-writable
+    files). Every file pyoa creates gets it."""
+    return 0o666 & ~_umask()
+
+
 def _renamed(exc: OSError, path: Path, tmp: str | None = None) -> OSError:
     """``exc`` as the same OSError subclass, saying it could not write ``path``.
 
@@ -116,7 +123,7 @@ def atomic_path(path: str | os.PathLike):
             yield Path(tmp)
             # mkstemp makes the file 0600; give it the mode a plain open() would
             # (or keep the mode of the file it replaces).
-            os.chmod(tmp, path.stat().st_mode & 0o7777 if path.exists() else 0o666 & ~_umask())
+            os.chmod(tmp, path.stat().st_mode & 0o7777 if path.exists() else new_file_mode())
             os.replace(tmp, path)
         except OSError as exc:
             if not _about_temp(exc, tmp, path):

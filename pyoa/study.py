@@ -136,9 +136,11 @@ class Job:
 
 def file_digest(path) -> str:
     """SHA-256 of a file's bytes (a reference's identity in a study.json of
-    pyoa before :func:`pixel_identity`)."""
+    pyoa before :func:`pixel_identity`); only a regular file is read."""
+    from .render.state import open_regular
+
     h = hashlib.sha256()
-    with open(path, "rb") as fh:
+    with open_regular(path, "a study's reference") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
@@ -194,28 +196,83 @@ def lock_study(d: Path):
     would append every row twice). The lock is the open file's, so the
     system releases it when the holder exits, however it exits; the file
     stays (removing it would let a third run lock a new file while the
-    second waits on the old one)."""
+    second waits on the old one).
+
+    The file is made with the mode of every file pyoa writes
+    (:func:`pyoa.atomic.new_file_mode`), so the users of a group-shared
+    ``--out`` can all lock it. One that this user may read but not write
+    (made by another user under a stricter umask) is locked through a
+    read-only descriptor, which ``flock`` accepts; the run cannot write its
+    name there then. A ``.lock`` that is a symlink or not a regular file is
+    refused, never followed (truncating it would empty the file it names)."""
+    import stat
+
+    from .atomic import new_file_mode
+    from .render.state import not_regular
+
     path = d / LOCK_NAME
+    what, fix = "the study's lock file", "remove it, or give another --out"
+    # O_NONBLOCK: the open of a FIFO does not wait for a writer
+    flags = os.O_NOFOLLOW | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0)
     try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | flags, new_file_mode())
+            writable = True
+        except PermissionError as denied:
+            try:
+                fd, writable = os.open(path, os.O_RDONLY | flags), False
+            except FileNotFoundError:  # no lock file, and none may be made
+                raise denied from None
     except OSError as exc:
+        if os.path.islink(path) or os.path.isdir(path):  # O_NOFOLLOW's ELOOP; a directory's EISDIR
+            raise not_regular(path, _mode(path), what, fix) from None
         raise type(exc)(f"--out: cannot create {str(path)!r}, the study's lock file: {exc.strerror}") from None
     try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise not_regular(path, mode, what, fix)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            holder = os.pread(fd, 512, 0).decode(errors="replace").split()
-            who = (f"process {holder[0]} on {holder[1]}" if len(holder) == 2 and holder[0].isdigit()
-                   else "another process")  # the holder has not written its name yet
-            raise ValueError(f"study directory {d} is in use by {who}; wait for it or use another --out") from None
+            raise ValueError(f"study directory {d} is in use by {_holder(fd)}; wait for it or use another "
+                             "--out") from None
         except OSError as exc:  # a file system without locks
             raise type(exc)(f"--out: cannot lock {str(path)!r} ({exc.strerror}); give an --out on a file system "
                             "with file locks") from None
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+        if writable:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
         yield
     finally:
         os.close(fd)  # releases the lock
+
+
+def _mode(path) -> int:
+    """The mode of what ``path`` names, following symlinks; 0 for a dangling one."""
+    try:
+        return os.stat(path).st_mode
+    except OSError:
+        return 0
+
+
+def _holder(fd: int) -> str:
+    """Who holds a study's lock, as its lock file ``fd`` names it:
+    ``process PID on HOST``, or ``another process`` when the file names no
+    one, or names a process of this host that has ended: a holder that could
+    only read the file (:func:`lock_study`) left an earlier run's name there,
+    and the holder may not have written its own yet."""
+    words = os.pread(fd, 512, 0).decode(errors="replace").split()
+    if len(words) != 2 or not words[0].isdecimal() or int(words[0]) <= 0:
+        return "another process"
+    pid, host = int(words[0]), words[1]
+    if host == socket.gethostname():
+        try:
+            os.kill(pid, 0)  # signal 0: only whether the process exists
+        except (ProcessLookupError, OverflowError):
+            return "another process"
+        except PermissionError:  # it exists, another user's
+            pass
+    return f"process {pid} on {host}"
 
 
 class Damaged(ValueError):
@@ -246,6 +303,8 @@ _SETTINGS = {
     "max_depth": (True, "null or an integer >= 1", lambda v: v is None or _is_int(v, 1)),
     "filter": (True, "a string", _is_str),
     "shading": (True, "a string", _is_str),
+    # absent in studies made before it was recorded: renderer version 1
+    "renderer": (False, "an integer >= 1", lambda v: _is_int(v, 1)),
     "scenes": (True, "an object of scenes", lambda v: isinstance(v, dict)),
     "runs": (False, "a list of runs", lambda v: isinstance(v, list)),
 }
@@ -281,18 +340,31 @@ def _check_fields(obj, fields: dict, where: str) -> None:
             raise Damaged(f"{where + '.' if where else ''}{name} is {json.dumps(obj[name])[:40]}, not {what}")
 
 
+#: Most bytes of a study.json: its settings and one record per scene and per
+#: run, a few hundred bytes each, so far more than any study's.
+MAX_SETTINGS_BYTES = 64 << 20
+
+
 def load_settings(path: Path) -> dict | None:
     """A study's saved settings (``study.json``), checked field by field
     before anything uses them; None when there is none. A file that is not
     JSON, of another version, or with a field pyoa did not write is refused
-    (ValueError naming the file and the field), before any render."""
+    (ValueError naming the file and the field), before any render; so is
+    one that is not a regular file (:func:`pyoa.render.state.open_regular`)
+    or holds over :data:`MAX_SETTINGS_BYTES`."""
+    from .render.state import open_regular
+
     if not path.exists():
         return None
     afresh = (f"the file is damaged: move it and {path.parent / 'study.csv'} away to start the study afresh, or "
               "give another --out")
+    with open_regular(path, "the study's settings") as fh:
+        data = fh.read(MAX_SETTINGS_BYTES + 1)
+    if len(data) > MAX_SETTINGS_BYTES:
+        raise ValueError(f"{path} holds over {MAX_SETTINGS_BYTES >> 20} MiB, not a study's settings; {afresh}")
     try:
-        saved = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
+        saved = json.loads(data)
+    except ValueError as exc:
         raise ValueError(f"{path} is not a study's settings ({type(exc).__name__}); {afresh}") from None
     if isinstance(saved, dict) and _is_int(saved.get("version")) and saved["version"] != STUDY_VERSION:
         raise ValueError(f"{path} was written by another pyoa version; give another --out")
@@ -315,6 +387,10 @@ def check_settings(out: Path, saved: dict | None, settings: dict) -> dict:
     (:func:`plan_references`)."""
     if saved is None:
         return settings
+    if saved.get("renderer", 1) != settings["renderer"]:
+        raise ValueError(f"{out} holds renders of pyoa's renderer version {saved.get('renderer', 1)}, and this pyoa "
+                         f"renders with version {settings['renderer']}, whose images differ (see "
+                         "pyoa.render.integrator.RENDERER_VERSION); give another --out to start a new study")
     for field in ("size", "crop", "max_depth", "filter", "shading"):
         if saved[field] != settings[field]:
             raise ValueError(f"{out} holds a study made with {field} {saved[field]}, not {settings[field]}; give "
@@ -353,8 +429,10 @@ def _row(raw: dict) -> dict | None:
         return None
     if not all(math.isfinite(row[k]) and row[k] >= 0 for k in ("relmse", "relmse_crop", "mse")):
         return None
-    if row["sampler"].lower() in catalogue.SAMPLERS:  # rows of pyoa before canonical names: BOSE is bose
+    try:  # rows of pyoa before catalogue names (BOSE is bose), by the catalogue's own lookup
         row["sampler"] = canonical_sampler(row["sampler"])
+    except ValueError:
+        pass  # a sampler this pyoa does not have: kept as written (the report lists only the asked ones)
     return row
 
 
@@ -366,10 +444,15 @@ def read_rows(path: Path, repair: bool = False) -> list[dict]:
     that disagree are refused. Sampler names are read as the catalogue
     spells them. With ``repair`` (the study's own run, holding the lock) the
     file is rewritten that way when it differs, saying so on stderr. A file
-    that is not a study's CSV is refused."""
+    that is not a study's CSV is refused, as is one that is not a regular
+    file (:func:`pyoa.render.state.open_regular`)."""
+    from .render.state import open_regular
+
     if not path.exists():
         return []
-    text = path.read_text()
+    # read from the descriptor that was checked (universal newlines, as Path.read_text)
+    with io.TextIOWrapper(open_regular(path, "the study's rows")) as fh:
+        text = fh.read()
     lines = text.splitlines(keepends=True)
     if not lines:
         return []
@@ -638,12 +721,15 @@ def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
 
 
 def _reference_noise(ref_path: Path, ref: np.ndarray, crop) -> tuple[float, float] | None:
-    """(image, crop) noise estimates of a reference from its variance file, or None without one."""
+    """(image, crop) noise estimates of a reference from its variance file, or None without one. A
+    variance path that is not a regular file is refused (reading a FIFO hangs), not taken for none."""
     from .render.image import read_image
     from .render.reference import variance_path
+    from .render.state import check_state_file
 
     vp = variance_path(ref_path)
-    if not vp.is_file():
+    check_state_file(vp, "the variance of a study's reference", "remove or rename it")
+    if not vp.exists():
         return None
     var = read_image(vp)[..., :3].astype(np.float64)
     if var.shape != ref.shape:
@@ -672,6 +758,26 @@ def _made_with(saved: dict) -> str:
     if spp and passes:
         return f"a reference of {_in_passes(spp, passes)} (--reference-spp {spp} --pass-spp {spp // passes})"
     return f"the given reference {saved.get('reference_name', '?')}"
+
+
+def _by_file(saved: dict) -> bool:
+    """Whether a scene's record names its reference by the SHA-256 of its
+    file's bytes (a study.json of pyoa before :func:`pixel_identity`)."""
+    ref = saved.get("reference")
+    return ref is not None and not ref.startswith(PIXELS)
+
+
+def _unverifiable(out: Path, name: str, saved: dict, there: str, back: Path | None) -> str:
+    """The refusal of a scene whose rows' reference is known by its file's
+    bytes (:func:`_by_file`) when ``there`` (what was found) is not that
+    file: nothing but that file can be checked against such an identity
+    (the same pixels written again, as a reference rendered again is, make
+    other bytes), so it is never taken on trust."""
+    again = f" (or put it back at {back})" if back is not None else ""
+    return (f"{out / 'study.json'} (of an older pyoa) knows the reference of its {name} rows, {_made_with(saved)}, "
+            f"only by the SHA-256 of its file, and {there}: no other file can be checked against that, not even one "
+            "of the same pixels (an EXR carries the time it was written, so a reference rendered again never "
+            f"matches); give the original file with --reference{again}, or give another --out")
 
 
 def _read_own(path: Path, saved: dict, dims) -> np.ndarray | None:
@@ -710,8 +816,12 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
         saved = settings["scenes"][name]
         if args.reference:
             path = Path(args.reference[i])
+            # OpenImageIO would wait on a FIFO for ever, and read /dev/zero until memory runs out
+            check_state_file(path, "--reference", "give the reference image itself")
             pixels = read_reference(path, "--reference", *dims)
             if name in measured and not is_reference(saved.get("reference"), path, pixels):
+                if _by_file(saved):
+                    raise ValueError(_unverifiable(out, name, saved, f"{path} is not that file", None))
                 raise ValueError(f"{out} holds {name} renders measured against {_made_with(saved)}, not {path}; "
                                  "give that reference, or another --out")
             plans[name] = ReferencePlan(path, pixels)
@@ -724,6 +834,15 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
             raise ValueError(f"{out} holds {name} renders measured against {_made_with(saved)}, not one of "
                              f"{_in_passes(args.reference_spp, passes)}; give the reference they used, or another "
                              "--out")
+        if name in measured and _by_file(saved):
+            # rows measured against a file known only by its bytes: that file, or nothing (rendered again, it
+            # would never match, so it is not rendered)
+            pixels = _read_own(path, saved, dims)
+            if pixels is None:
+                there = f"{path} is {'missing' if not os.path.lexists(path) else 'not that file'}"
+                raise ValueError(_unverifiable(out, name, saved, there, path))
+            plans[name] = ReferencePlan(path, pixels, made_with=made_with)
+            continue
         state = state_path(path)
         # a device or FIFO there would hang the read; refused now, not after the other scenes' references
         check_state_file(state, "where pyoa study keeps its running sum")
@@ -747,6 +866,7 @@ def run(args) -> int:
     from .cluster import check_engine, engine, progress_over
     from .render.commands import _check_job_memory, _default_crop
     from .render.image import check_crop, read_reference
+    from .render.integrator import RENDERER_VERSION
     from .render.reference import render_reference
     from .render.render import plan, resolve_shading
     from .render.scene import load
@@ -813,8 +933,8 @@ def run(args) -> int:
                     jobs += [Job(scene.name, name, asked, n, seed0 + k) for k in range(seeds)]
         crop = tuple(args.crop) if args.crop else _default_crop((dims[1], dims[0]))
         check_crop(crop, *dims)
-        settings = dict(version=STUDY_VERSION, size=list(dims), crop=list(crop), max_depth=args.max_depth,
-                        filter=args.filter, shading=shading,
+        settings = dict(version=STUDY_VERSION, renderer=RENDERER_VERSION, size=list(dims), crop=list(crop),
+                        max_depth=args.max_depth, filter=args.filter, shading=shading,
                         scenes={n: dict(digest=scene_digest(s)) for n, s in loaded.items()})
         settings = check_settings(out, saved, settings)
         for r in rows:

@@ -42,6 +42,12 @@ from .layout import Layout
 RR_DEPTH = 5
 #: Key of the Russian-roulette hash (not a sampler dimension, see layout).
 RR_KEY = 0x7FEB352D
+#: Version of what a render computes, bumped whenever the images of the same
+#: settings change (the estimator, ray offsets, scene loading): progressive
+#: and reference states and studies record it, and work of another version is
+#: never mixed into theirs. 2: ray offsets follow each hit point's own float32
+#: error (issue 33); 1: offsets of 1e-4 of the scene's largest coordinate.
+RENDERER_VERSION = 2
 # The two factors below were checked with a stress test of Embree's answers:
 # new rays leaving hit points of the Cornell box (counted when they hit the
 # shape they left) and shadow rays from them to its light with the boxes

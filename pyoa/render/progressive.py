@@ -45,7 +45,7 @@ import numpy as np
 
 from .. import catalogue
 from .image import check_finite, write_exr, write_png
-from .integrator import Stats
+from .integrator import RENDERER_VERSION, Stats
 from .render import plan, render, resolve_shading
 from .state import (
     BadState,
@@ -61,7 +61,9 @@ from .state import (
 #: Version of the progressive state's layout and key.
 STATE_VERSION = 1
 #: Settings of the key, and how the user sets them (for the refusal to resume).
-_KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
+_KEY_FIELDS = {"version": "another pyoa version",
+               "renderer": "another version of pyoa's renderer (its images differ)",
+               "scene": "another scene file (or scene contents)",
                "width": "--size", "height": "--size", "max_depth": "--max-depth", "sampler": "--sampler",
                "base": "--base", "seed": "--seed", "filter": "--filter", "first": "--first",
                "shading": "--shading", "spp": "--spp"}
@@ -101,7 +103,7 @@ def check_progressive(name: str) -> None:
 def _describe_change(saved: dict, key: dict) -> str:
     for fld, option in _KEY_FIELDS.items():
         if saved.get(fld) != key.get(fld):
-            if fld in ("scene", "first", "version"):
+            if fld in ("scene", "first", "version", "renderer"):
                 return f"it was made with {option}"
             if fld in ("width", "height"):
                 return describe_size(saved, key)
@@ -208,9 +210,9 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
     p = plan(scene, sampler=sampler, spp=spp, seed=seed, width=width, height=height, max_depth=max_depth,
              filter=filter, first=first, backend=backend, base=base, max_bytes=max_bytes)
     smp = p.sampler
-    key = dict(version=STATE_VERSION, scene=scene_digest(scene), width=p.width, height=p.height,
-               max_depth=p.layout.max_depth, sampler=smp.name, base=smp.base, seed=smp.seed, filter=filter,
-               first=list(p.layout.names), shading=resolve_shading(shading),
+    key = dict(version=STATE_VERSION, renderer=RENDERER_VERSION, scene=scene_digest(scene), width=p.width,
+               height=p.height, max_depth=p.layout.max_depth, sampler=smp.name, base=smp.base, seed=smp.seed,
+               filter=filter, first=list(p.layout.names), shading=resolve_shading(shading),
                spp=None if entry.spp_invariant else smp.spp)
     total, done = None, 0
     if resume and state.exists():

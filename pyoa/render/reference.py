@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .image import check_finite, write_exr
+from .integrator import RENDERER_VERSION
 from .state import BadState, check_state_file, describe_size, read_state_arrays, scene_digest, state_path, write_state
 from .tiles import worker_render
 
@@ -37,7 +38,9 @@ REFERENCE_KEY = 0x52454631
 #: Version of the state file's layout and key (a state of another version is not resumed).
 STATE_VERSION = 3
 #: Options named when a state's key differs from this run's (key field -> how to say it).
-_KEY_FIELDS = {"version": "another pyoa version", "scene": "another scene file (or scene contents)",
+_KEY_FIELDS = {"version": "another pyoa version",
+               "renderer": "another version of pyoa's renderer (its images differ)",
+               "scene": "another scene file (or scene contents)",
                "width": "--size", "height": "--size", "max_depth": "--max-depth", "sampler": "--sampler",
                "pass_spp": "--pass-spp", "passes": "--spp", "seed": "--seed", "filter": "--filter",
                "first": "--first", "shading": "--shading"}
@@ -63,9 +66,9 @@ def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int, filter: st
     """Every setting that changes the bits of a reference pass (the backend
     and the engine do not: every backend gives the same samples, every engine
     the same images)."""
-    return dict(version=STATE_VERSION, scene=scene_digest(scene), width=p.width, height=p.height,
-                max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=pass_spp, passes=passes,
-                seed=seed, filter=filter, first=list(p.layout.names), shading=shading)
+    return dict(version=STATE_VERSION, renderer=RENDERER_VERSION, scene=scene_digest(scene), width=p.width,
+                height=p.height, max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=pass_spp,
+                passes=passes, seed=seed, filter=filter, first=list(p.layout.names), shading=shading)
 
 
 def _total_spp(key: dict):
@@ -80,7 +83,7 @@ def describe_change(saved: dict, key: dict) -> str:
     """Why a saved key is not this run's, as the user would set it: the first field that differs."""
     for field, option in _KEY_FIELDS.items():
         if saved.get(field) != key[field]:
-            if field in ("scene", "first", "version"):
+            if field in ("scene", "first", "version", "renderer"):
                 return f"made with {option}"
             if field in ("width", "height"):
                 return describe_size(saved, key)

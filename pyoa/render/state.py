@@ -60,7 +60,12 @@ class BadState(Exception):
 
 
 class NotRegularFile(ValueError):
-    """A state path that is not a regular file: it is neither read nor replaced."""
+    """A path pyoa reads (a state, a study's files) that is not a regular
+    file: it is neither read nor replaced."""
+
+
+#: What a refusal of a path that is not a regular file suggests by default.
+NOT_REGULAR_FIX = "remove or rename it, or give another --out"
 
 
 def scene_digest(scene) -> str:
@@ -71,26 +76,32 @@ def scene_digest(scene) -> str:
     return h.hexdigest()
 
 
-def _not_regular(state: Path, mode: int, what: str) -> NotRegularFile:
-    kind = next((name for test, name in _KINDS if test(mode)), "a file of another kind")
-    if state.is_symlink():
-        kind = f"a symlink to {os.path.realpath(state)!r}, {kind}"
-    return NotRegularFile(f"{str(state)!r} ({what}) is {kind}, not a regular file; remove or rename it, or "
-                          "give another --out")
+def not_regular(path, mode: int, what: str, fix: str = NOT_REGULAR_FIX) -> NotRegularFile:
+    """The refusal of ``path`` (``what`` says whose file it is), a file of
+    ``mode`` (its target's, for a symlink) that is not a regular file: one
+    line naming what it is, and ``fix``."""
+    path = Path(path)
+    kind = next((name for test, name in _KINDS if test(mode)), None)
+    if path.is_symlink():  # a symlink refused as such (O_NOFOLLOW) may name a regular file, or nothing
+        kind = f"a symlink to {os.path.realpath(path)!r}" + (f", {kind}" if kind else "")
+    return NotRegularFile(f"{str(path)!r} ({what}) is {kind or 'a file of another kind'}, not a regular file; "
+                          f"{fix}")
 
 
-def check_state_file(state, what: str) -> None:
+def check_state_file(state, what: str, fix: str = NOT_REGULAR_FIX) -> None:
     """Refuse (:class:`NotRegularFile`, a ValueError naming the path and what
     it is) a state path that exists and is not a regular file once symlinks
     are followed: a device (reading ``/dev/zero`` never ends), a FIFO
     (reading blocks), a directory. Such a path is neither read nor replaced. ``what`` says whose state it
-    is, e.g. ``"where pyoa reference keeps its running sum"``."""
+    is, e.g. ``"where pyoa reference keeps its running sum"``; ``fix`` what
+    the refusal suggests. Every file pyoa reads that a user could replace
+    is checked so (this, or :func:`open_regular`)."""
     try:
         mode = os.stat(state).st_mode
     except FileNotFoundError:  # absent, or a dangling symlink: the first write makes the file
         return
     if not stat.S_ISREG(mode):
-        raise _not_regular(Path(state), mode, what)
+        raise not_regular(state, mode, what, fix)
 
 
 class _Capped:
@@ -123,22 +134,32 @@ class _Capped:
         return True
 
 
-def _open_regular(state: Path):
-    """``state`` opened for reading (binary), refused (ValueError) unless it is
-    a regular file: the check is made on the open file, so the file read is
-    the file checked. A file that cannot be opened is a BadState."""
-    try:  # O_NONBLOCK: the open of a FIFO would wait for a writer
-        fd = os.open(state, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    except OSError as exc:
-        raise BadState(_first_line(exc)) from None
+def open_regular(path, what: str, fix: str = NOT_REGULAR_FIX):
+    """``path`` opened for reading (binary), refused (:class:`NotRegularFile`,
+    see :func:`not_regular`) unless it is a regular file: the check is made on
+    the open file, so the file read is the file checked (a symlink to
+    ``/dev/zero`` would be read for ever, a FIFO blocks). An open that fails
+    raises its OSError."""
+    # O_NONBLOCK: the open of a FIFO would wait for a writer
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            raise _not_regular(state, mode, "a state file")
+            raise not_regular(path, mode, what, fix)
         return os.fdopen(fd, "rb")
     except BaseException:
         os.close(fd)
         raise
+
+
+def _open_regular(state: Path):
+    """A state file opened as :func:`open_regular`; one that cannot be opened is a BadState."""
+    try:
+        return open_regular(state, "a state file")
+    except NotRegularFile:
+        raise
+    except OSError as exc:
+        raise BadState(_first_line(exc)) from None
 
 
 def _member(zf: zipfile.ZipFile, name: str, check) -> np.ndarray:
@@ -146,7 +167,15 @@ def _member(zf: zipfile.ZipFile, name: str, check) -> np.ndarray:
     header (and raises BadState) before any array is made from it, and the
     header may not claim more data than the member holds: nothing larger
     than the member is ever allocated."""
-    raw = zf.read(f"{name}.npy")  # at most its file_size, checked by the caller
+    info = zf.getinfo(f"{name}.npy")  # its file_size is checked by the caller
+    # Read no more than the member says it holds: zf.read() would inflate a
+    # compressed member whole, whatever its header claims (a small forged
+    # file can inflate to gigabytes), before its CRC check fails.
+    with zf.open(info) as member:
+        raw = member.read(info.file_size + 1)
+    if len(raw) != info.file_size:
+        raise BadState(f"its member {name}.npy holds {'more' if len(raw) > info.file_size else 'fewer'} bytes than "
+                       f"its zip header says ({info.file_size})")
     fp = io.BytesIO(raw)
     version = np.lib.format.read_magic(fp)
     if version not in ((1, 0), (2, 0)):

@@ -37,6 +37,7 @@ import numpy as np
 import pytest
 
 from pyoa.render.image import read_image, write_exr
+from pyoa.render.integrator import RENDERER_VERSION
 from pyoa.render.progressive import render_progressive, state_path
 from pyoa.render.reference import Passes, reference_key
 from pyoa.render.render import SCENE_TRIANGLE_BYTES, plan, render
@@ -184,6 +185,52 @@ def test_a_progressive_state_of_another_size_names_the_size(progressive_state, t
     assert snapshot(out, state) == before
 
 
+def _as_renderer_1(state):
+    """Rewrite a state's key as renderer version 1 wrote it (no ``renderer`` field)."""
+    with np.load(state) as z:
+        members = {k: z[k] for k in z.files}
+    key = json.loads(str(members["key"][()]))
+    assert key.pop("renderer") == RENDERER_VERSION
+    members["key"] = np.array(json.dumps(key))
+    with open(state, "wb") as fh:
+        np.savez(fh, **members)
+
+
+def test_work_of_another_renderer_version_is_not_mixed_in(progressive_state, tmp_path, as_limit):
+    """Progressive and reference states made before the ray offsets changed
+    (renderer version 1: no ``renderer`` in their key) are not resumed into
+    this version's images: the progressive render refuses, naming the cause;
+    the reference starts over; a study of version 1 is refused."""
+    out, state = copy_progressive(progressive_state, tmp_path)
+    _as_renderer_1(state)
+    before = snapshot(out, state)
+    res = pyoa([*PROGRESSIVE, "--size", "16", "16", "--out", out, "-q"], as_limit)
+    refused(res, "render", r"cannot resume .*: it was made with another version of pyoa's renderer")
+    assert snapshot(out, state) == before
+
+    ref = tmp_path / "ref.exr"
+    scene = load("cornell")
+    p = plan(scene, sampler="sobol", spp=4, width=8, height=8)
+    key = reference_key(scene, p, pass_spp=4, passes=1, seed=0, filter="box", shading="numpy")
+    Passes(state_path(ref), key, quiet=True).add(0, np.ones((8, 8, 3), np.float32))
+    _as_renderer_1(state_path(ref))
+    res = pyoa([*REFERENCE, "--size", "8", "8", "--out", ref, "-q"], as_limit)
+    assert res.returncode == 0 and res.stderr.splitlines() == [
+        f"pyoa reference: not resuming {state_path(ref)} (made with another version of pyoa's renderer (its images "
+        "differ)): starting over"], res.stderr
+    assert read_image(ref).mean() != 1.0
+
+    from pyoa.study import check_settings
+
+    settings = dict(version=1, renderer=RENDERER_VERSION, size=[8, 8], crop=[0, 0, 8, 8], max_depth=None,
+                    filter="box", shading="numba", scenes={})
+    saved = {k: v for k, v in settings.items() if k != "renderer"}
+    with pytest.raises(ValueError, match=r"holds renders of pyoa's renderer version 1, and this pyoa renders with "
+                                         rf"version {RENDERER_VERSION}"):
+        check_settings(tmp_path, saved, settings)
+    assert check_settings(tmp_path, dict(settings), settings)["renderer"] == RENDERER_VERSION
+
+
 def test_a_forged_header_of_a_reference_state_starts_over(tmp_path, as_limit):
     """pyoa reference does not resume a state that holds no valid sums: it
     says why in one line and renders afresh, nothing allocated from the header."""
@@ -218,6 +265,59 @@ def test_a_header_claiming_more_than_its_member_holds_is_not_read(tmp_path, as_l
     """, as_limit)
     assert res.returncode == 0 and res.stdout == ("its member images.npy is cut short: its header claims float32 "
                                                   "(99999, 64, 64, 3) (4915150848 bytes), it holds 64 bytes\n"), res
+
+
+def test_a_compressed_member_is_not_inflated_beyond_its_stated_size(tmp_path, as_limit):
+    """A state whose ``sum.npy`` is deflated zeros of 160 MiB (160 KiB in the
+    file) with its zip header saying 1.5 MiB, what a 256 x 256 sum holds: refused, and nothing near the
+    inflated size is allocated (a child under the memory cap; ``zf.read``
+    used to inflate the member whole before its CRC check failed)."""
+    import struct
+    import zipfile
+
+    state = tmp_path / "ref.exr.state.npz"
+    key = dict(width=256, height=256, passes=8)
+    write_state(state, np.zeros((256, 256, 3)), "passes", 0, key, sumsq=np.zeros((256, 256, 3)),
+                pending=np.zeros(0, np.int64), images=np.zeros((0, 256, 256, 3), np.float32))
+    members = {}
+    with zipfile.ZipFile(state) as zf:
+        for info in zf.infolist():
+            members[info.filename] = zf.read(info)
+    header = members["sum.npy"][:128]  # the .npy header of a (256, 256, 3) float64 array
+    with zipfile.ZipFile(state, "w") as zf:
+        for name, data in members.items():
+            if name == "sum.npy":
+                zf.writestr(name, header + bytes(160 << 20), compress_type=zipfile.ZIP_DEFLATED)
+            else:
+                zf.writestr(name, data)
+    raw = bytearray(state.read_bytes())
+    stated = len(members["sum.npy"])
+    for sig, at in ((b"PK\x03\x04", 22), (b"PK\x01\x02", 24)):  # local and central headers: uncompressed size
+        k = -1
+        while (k := raw.find(sig, k + 1)) >= 0:
+            name_len = struct.unpack_from("<H", raw, k + (26 if sig == b"PK\x03\x04" else 28))[0]
+            name_at = k + (30 if sig == b"PK\x03\x04" else 46)
+            if raw[name_at:name_at + name_len] == b"sum.npy":
+                struct.pack_into("<I", raw, k + at, stated)
+    state.write_bytes(bytes(raw))
+    assert state.stat().st_size < 4 << 20
+    res = python_child(f"""
+        from pyoa.render.state import BadState, read_state_arrays
+
+        def peak():
+            return next(int(l.split()[1]) for l in open("/proc/self/status") if l.startswith("VmHWM")) << 10
+
+        before = peak()
+        try:
+            read_state_arrays({str(state)!r}, {key!r}, "passes", 8, None, ("sum", "sumsq"), pending=True)
+        except BadState as why:
+            print(why)
+        print((peak() - before) >> 20)
+    """, as_limit)
+    # refused either way: it inflates to more than its header says, or its CRC fails at that size;
+    # what matters is that it is never inflated whole (160 MiB): a few MiB at most
+    why, grown = res.stdout.splitlines()
+    assert res.returncode == 0 and "sum.npy" in why and int(grown) < 48, res
 
 
 # -- the scene in the memory plan (item 14) -------------------------------------------------------
