@@ -27,9 +27,12 @@ Conventions are Mitsuba's:
   can load (``file`` is relative to the scene file).
 * ``to_world`` is a row-major 4x4 affine matrix applied to column vectors
   (default: identity). A triangle's geometric normal is
-  ``cross(v1 - v0, v2 - v0)`` of its world-space vertices; where
+  ``cross(v1 - v0, v2 - v0)`` of its world-space vertices as stored and
+  traced, in float32 (:func:`triangle_geometry`); where
   ``det(to_world[:3, :3]) < 0`` the winding of every triangle is reversed so
-  that normals keep pointing to the front (outwards).
+  that normals keep pointing to the front (outwards). A mesh's triangles
+  that are flat in float32 (``FLAT_RATIO``) are dropped; a ``rectangle`` or
+  ``cube`` whose ``to_world`` makes them flat is refused.
 * ``emission`` (RGB radiance, in [0, 3.4e38], what a float32 image can hold) turns a shape into an area light that emits
   on its front side only. A scene needs at least one emitter.
 * ``camera.fov`` is in degrees along the smaller image axis; ``aperture`` is
@@ -47,7 +50,8 @@ Conventions are Mitsuba's:
   (:func:`_check_float32_precision`): its largest coordinate (vertices and
   camera) at most ``MAX_POSITION_RATIO`` = 2^15 times its extent (the scene
   spans at least 256 float32 steps), and its extent at most ``MAX_EXTENT`` =
-  1e12 (the products of Embree's ray-triangle test stay within float32).
+  1e12 (the products of Embree's ray-triangle test stay within float32) and
+  at least ``MIN_EXTENT`` = 1e-9.
 
 Every error found on load is a :class:`ValueError` whose message names the
 file and the field (``cornell.json: shapes[3].material: unknown material
@@ -58,9 +62,11 @@ as ``pyoa.scenes``) load by name: ``load("cornell")``.
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import os
+import weakref
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -68,6 +74,7 @@ from pathlib import Path
 import numpy as np
 
 from pyoa.render.bsdf import Materials
+from pyoa.render.geometry import dot
 from pyoa.render.layout import MAX_DEPTH
 
 __all__ = ["Camera", "Scene", "SceneError", "UnknownSceneError", "load", "bundled", "rectangle", "cube"]
@@ -108,8 +115,8 @@ class Scene:
     path: str  # the file it came from
     name: str  # file stem
     triangles: np.ndarray  # (T, 3, 3) float32, world space
-    normals: np.ndarray  # (T, 3) float64 unit geometric normals
-    areas: np.ndarray  # (T,) float64
+    normals: np.ndarray  # (T, 3) float64 unit geometric normals of the float32 triangles (triangle_geometry)
+    areas: np.ndarray  # (T,) float64, of the float32 triangles
     material: np.ndarray  # (T,) int32 material id per triangle
     emission: np.ndarray  # (T, 3) float64, 0 for non-emitters
     materials: Materials
@@ -171,6 +178,8 @@ MAX_POSITION_RATIO = 2.0**15
 #: Largest extent of a scene (the longest side of the bounding box of its
 #: vertices and camera); see _check_float32_precision.
 MAX_EXTENT = 1e12
+#: Smallest extent of a scene; see _check_float32_precision.
+MIN_EXTENT = 1e-9
 #: Longest integer literal read from a scene file (Python's own limit on
 #: int-from-string conversion is 4300 digits; no field needs more than a few).
 MAX_INT_DIGITS = 100
@@ -306,9 +315,48 @@ def _transform(tris: np.ndarray, m: np.ndarray) -> np.ndarray:
     return out
 
 
+#: A triangle is flat, and dropped from a mesh (a ``rectangle`` or ``cube``
+#: made flat by its ``to_world`` is refused), when its float32 vertices, the
+#: ones stored and traced, rise less than ``FLAT_RATIO`` of its longest edge
+#: above it (twice its area under ``FLAT_RATIO`` times the edge squared):
+#: the height of 16 float32 steps of the edge's length. Embree computes the
+#: triangle's normal in float32, which turns by about 2^-24 of the edge over
+#: the height for a triangle whose edges are all long (a cap): beyond 2^-4
+#: radian below this ratio, and the ray offsets that keep new rays off such
+#: a triangle (pyoa.render.integrator.triangle_reach) would exceed its size.
+#: Triangles of zero area in float32 (``[[0,0,0],[1,1,1],[2,2,2+1e-7]]``)
+#: have no normal at all.
+FLAT_RATIO = 2.0**-20
+_FLAT = "twice the area under 2^-20 times the longest edge squared"
+
+
+def triangle_geometry(triangles: np.ndarray):
+    """``(normals, areas, keep)`` of the ``(T, 3, 3)`` float32 triangles, as
+    they are stored and traced: the unit geometric normals ``cross(v1 - v0,
+    v2 - v0)`` and the areas (``(T, 3)`` and ``(T,)`` float64, computed in
+    float64 from the float32 vertices, whose differences and products are
+    then exact or nearly), and which triangles are not flat (``FLAT_RATIO``;
+    a flat one's normal is 0). The one place where the normals that shading,
+    light sampling and ray offsets use are computed."""
+    v0 = triangles[:, 0].astype(np.float64)
+    e1 = triangles[:, 1] - v0
+    e2 = triangles[:, 2] - v0
+    del v0
+    cross = np.cross(e1, e2)
+    longest2 = np.maximum(dot(e1, e1), dot(e2, e2))
+    e2 -= e1
+    np.maximum(longest2, dot(e2, e2), out=longest2)
+    del e1, e2
+    twice_area = np.sqrt(dot(cross, cross))
+    keep = twice_area > FLAT_RATIO * longest2
+    cross /= np.where(keep, twice_area, 1.0)[:, None]
+    cross[~keep] = 0.0
+    return cross, 0.5 * twice_area, keep
+
+
 def _check_float32_precision(ctx: _Ctx, bounds, camera: Camera, shapes) -> None:
     """Refuse (:class:`SceneError`) a scene that Embree's float32 ray tracing
-    cannot resolve. Both rules look at the axis-aligned box around the
+    cannot resolve. The rules look at the axis-aligned box around the
     vertices (``bounds``: ``(index, low corner, high corner)`` of each shape
     in world space) and the camera (its positions when the shutter opens and
     closes, widened by the lens radius); the extent ``E`` is the box's
@@ -327,6 +375,13 @@ def _check_float32_precision(ctx: _Ctx, bounds, camera: Camera, shapes) -> None:
       and rays miss (the cornell box scaled by 3e12 loses 22 % of the image
       mean, by 1e13 99 %). Such a scene must be scaled down, or its camera
       brought closer.
+    * ``E >= MIN_EXTENT`` (1e-9): below about 1e-11 the renderer's guards
+      against zero lengths (1e-12) and Embree's float32 products (under
+      1.2e-38, float32's smallest normal number, below about 2e-13) take
+      over: the cornell box 4.9e-11 across renders as it does 4.9 across,
+      4.9e-12 across 1.4 % darker, 9.8e-13 across 35 %. Such a scene must be
+      scaled up. (Triangles are flat relative to their own size,
+      ``FLAT_RATIO``: this rule, not that one, refuses a tiny scene.)
 
     Scaling alone keeps ``C / E``, and the renderer's ray offsets follow the
     size of the geometry (``pyoa.render.integrator.offset_distance``), so a
@@ -345,6 +400,11 @@ def _check_float32_precision(ctx: _Ctx, bounds, camera: Camera, shapes) -> None:
                             f"that Embree's float32 ray tracing handles: its ray-triangle test multiplies three "
                             f"coordinate differences, which overflow float32 (3.4e38), and rays miss; "
                             f"scale the scene down or bring the camera closer")
+    if extent < MIN_EXTENT:
+        raise ctx.error("", f"the scene is {extent:.3g} across (vertices and camera), under the {MIN_EXTENT:.0e} "
+                            f"that pyoa's renderer handles: its guards against zero lengths and Embree's float32 "
+                            f"products of coordinate differences take over, and the image is wrong; "
+                            f"scale the scene up")
     per_shape = np.maximum(np.abs(lows), np.abs(highs)).max(axis=1)
     k = int(per_shape.argmax())
     largest_cam = float(np.abs(cam).max())
@@ -468,16 +528,27 @@ def _materials(ctx: _Ctx, v) -> tuple[Materials, dict[str, int]]:
 MESH_FILE_FACTOR = 12
 #: Peak memory of loading a mesh, per triangle: trimesh's arrays, the float64
 #: world-space copies made here and the scene's own arrays. Measured the same
-#: way: 440 bytes (GLB), 443 (OBJ), 497 (binary PLY) and 718 (binary STL,
-#: which repeats every vertex); 1 KiB with a margin. Checked once the file
-#: is parsed, before the copies are made, for all of a scene's meshes
-#: together (a scene of many meshes is overestimated: only the last is
-#: being copied at the peak).
+#: way: 236 bytes (GLB), 273 (binary PLY), 289 (OBJ) and 494 (binary STL,
+#: which repeats every vertex); 1 KiB with a margin (440 to 718 while the
+#: parsed mesh waited for the garbage collector). Checked once the file is
+#: parsed, before the copies are made.
 MESH_TRIANGLE_BYTES = 1024
+#: Memory per triangle of the meshes loaded before one: their float64
+#: world-space vertices (72 bytes) while it loads, then the scene's arrays
+#: as they are built and joined (float32 vertices, float64 normals, areas
+#: and emission, ids: 76 bytes, twice while they are joined). Measured as
+#: the peak of scenes of 2, 4 and 8 binary PLY meshes of 250 000 triangles
+#: less that of one, per triangle of the others: 130, 202 and 192 bytes;
+#: 256 with a margin. A mesh is checked at MESH_TRIANGLE_BYTES per triangle
+#: of its own plus this per triangle of the meshes before it: only one mesh
+#: is parsed and copied at a time (ten meshes of 1M triangles: 3.1 GiB, not
+#: the 9.5 GiB of 1 KiB each).
+MESH_KEPT_BYTES = 256
 
 
 class _MeshMemory:
-    """The memory limit of a scene's meshes and the triangles loaded so far."""
+    """The memory limit of a scene's meshes and the triangles of the meshes
+    loaded so far (kept at ``MESH_KEPT_BYTES`` each while the next loads)."""
 
     def __init__(self, limit: int):
         self.limit, self.triangles = limit, 0
@@ -510,11 +581,21 @@ def _mesh(ctx: _Ctx, where: str, file, base: Path, memory: _MeshMemory) -> np.nd
     vertices = getattr(mesh, "vertices", None)
     if faces is None or vertices is None or len(faces) == 0:
         raise ctx.error(where, f"mesh {rel!r} has no triangles")
-    memory.triangles += len(faces)
-    also = f" ({memory.triangles} with the meshes before it)" if memory.triangles > len(faces) else ""
-    memory.check(ctx, where, memory.triangles * MESH_TRIANGLE_BYTES,
+    kept = memory.triangles
+    also = f" (and the {kept} triangles of the meshes before it)" if kept else ""
+    memory.check(ctx, where, len(faces) * MESH_TRIANGLE_BYTES + kept * MESH_KEPT_BYTES,
                  f"loading mesh {rel!r} of {len(faces)} triangles{also}")
+    memory.triangles += len(faces)
     tris = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
+    # A trimesh mesh is a reference cycle: left to the garbage collector, its
+    # arrays (about 180 bytes per triangle) stayed while the next meshes
+    # loaded. Collecting the young generations is cheap (ms); the whole heap
+    # (about 0.1 s) only if the mesh got older.
+    gone = weakref.ref(mesh)
+    del mesh, faces, vertices
+    gc.collect(1)
+    if gone() is not None:
+        gc.collect()
     if tris.ndim != 3 or tris.shape[1:] != (3, 3) or not np.isfinite(tris).all():
         raise ctx.error(where, f"mesh {rel!r} has invalid vertex data")
     return tris
@@ -531,8 +612,8 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path, camera: Camera, memor
         raise ctx.error("shapes", f"expected a list of shapes, got {_show(v)}")
     if not v:
         raise ctx.error("shapes", "no shapes")
-    shapes = []  # (index, shape, world, material id, emission), checked for precision before degeneracy
-    tris, mats, ems, owner = [], [], [], []
+    shapes = []  # (index, shape, world, material id, emission), checked for precision before flatness
+    tris, normals, areas, mats, ems, owner = [], [], [], [], [], []
     valid_mats = ", ".join(ids)
     for i, s in enumerate(v):
         where = f"shapes[{i}]"
@@ -561,31 +642,36 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path, camera: Camera, memor
             # a larger radiance would be inf in the float32 image
             emission = _vector(ctx, f"{where}.emission", s["emission"], lo=0, hi=FLOAT32_MAX)
         world = _transform(local, m)
+        del local  # not kept while the next mesh loads (MESH_KEPT_BYTES)
         if not np.all(np.abs(world) <= FLOAT32_MAX):  # triangles are stored (and traced) as float32
             field_ = f"{where}.to_world" if "to_world" in s else f"{where}.file"
             raise ctx.error(field_, f"vertices beyond the float32 range (|x| <= {FLOAT32_MAX:.4g}) in world space")
         shapes.append((i, s, world, ids[name], emission))
-    # before the degeneracy test below, whose area threshold grows with the
-    # coordinates: a scene far from the origin is refused as far, not as flat
+    # before the flatness test below, of the float32 vertices: a scene far
+    # from the origin is refused as far, not as flat
     _check_float32_precision(ctx, [(i, w.min(axis=(0, 1)), w.max(axis=(0, 1))) for i, _s, w, _m, _e in shapes],
                              camera, v)
     for j, (i, s, world, mat, emission) in enumerate(shapes):
-        shapes[j] = None  # a mesh's unfiltered copy goes once world[keep] replaces it
+        shapes[j] = None  # the float64 copy goes once its float32 one replaces it
         where, t = f"shapes[{i}]", s["type"]
-        cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
-        area2 = np.linalg.norm(cross, axis=1)
-        keep = area2 > 1e-12 * max(1.0, float(np.abs(world).max())) ** 2
+        world = world.astype(np.float32)  # as stored and traced
+        normal, area, keep = triangle_geometry(world)
         if t == "mesh":
-            world = world[keep]  # a mesh may carry degenerate faces: no area, no normal
+            if not keep.all():  # a mesh may carry degenerate faces: no area, no normal
+                world, normal, area = world[keep], normal[keep], area[keep]
             if len(world) == 0:
-                raise ctx.error(f"{where}.file", f"mesh {s['file']!r} has only degenerate triangles")
-        elif not keep.all():  # cannot happen with an invertible to_world
-            raise ctx.error(f"{where}.to_world", "the transform makes triangles degenerate")
+                raise ctx.error(f"{where}.file", f"mesh {s['file']!r} has only degenerate triangles "
+                                                 f"(flat in float32: {_FLAT})")
+        elif not keep.all():
+            raise ctx.error(f"{where}.to_world", f"the transform makes triangles flat in float32 ({_FLAT}); "
+                                                 f"scale the shape less unevenly")
         tris.append(world)
+        normals.append(normal)
+        areas.append(area)
         mats.append(np.full(len(world), mat, dtype=np.int32))
         ems.append(np.tile(emission, (len(world), 1)))
         owner.append(np.full(len(world), i, dtype=np.int32))
-    return np.concatenate(tris), np.concatenate(mats), np.concatenate(ems), np.concatenate(owner)
+    return tuple(np.concatenate(a) for a in (tris, normals, areas, mats, ems, owner))
 
 
 def _load_file(path: Path, max_bytes: int) -> Scene:
@@ -606,17 +692,16 @@ def _load_file(path: Path, max_bytes: int) -> Scene:
     mis = _boolean(ctx, "integrator.mis", integ.get("mis", True))
     materials, ids = _materials(ctx, data["materials"])
     memory = _MeshMemory(max_bytes)
-    world, material, emission, owner = _shapes(ctx, data["shapes"], ids, path.parent, camera, memory)
+    world, normals, areas, material, emission, owner = _shapes(ctx, data["shapes"], ids, path.parent, camera,
+                                                               memory)
     if not (emission.max(axis=1) > 0).any():
         raise ctx.error("shapes", "no shape has a nonzero emission: nothing would be lit")
-    cross = np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0])
-    length = np.linalg.norm(cross, axis=1)
     return Scene(
         path=str(path),
         name=path.stem,
-        triangles=_frozen(world.astype(np.float32)),
-        normals=_frozen(cross / length[:, None]),
-        areas=_frozen(0.5 * length),
+        triangles=_frozen(world),
+        normals=_frozen(normals),
+        areas=_frozen(areas),
         material=_frozen(material),
         emission=_frozen(emission),
         materials=materials,
@@ -647,8 +732,10 @@ def load(scene: str | os.PathLike, max_bytes: int | str | None = None) -> Scene:
     Its meshes must load within the memory limit ``max_bytes`` (default
     ``$PYOA_MAX_BYTES``, else half the usable memory: :func:`pyoa.render.render.resolve_max_bytes`):
     a mesh file is refused before it is parsed if its size, and once parsed
-    if the scene's triangles so far, need more (``MESH_FILE_FACTOR`` per
-    byte, ``MESH_TRIANGLE_BYTES`` per triangle); a :class:`SceneError`."""
+    if its triangles with those of the meshes before it, need more
+    (``MESH_FILE_FACTOR`` per byte, ``MESH_TRIANGLE_BYTES`` per triangle of
+    the mesh, ``MESH_KEPT_BYTES`` per triangle before it); a
+    :class:`SceneError`."""
     from .render import resolve_max_bytes
 
     limit = resolve_max_bytes(max_bytes)

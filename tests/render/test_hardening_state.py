@@ -41,7 +41,7 @@ from pyoa.render.integrator import RENDERER_VERSION
 from pyoa.render.progressive import render_progressive, state_path
 from pyoa.render.reference import Passes, reference_key
 from pyoa.render.render import SCENE_TRIANGLE_BYTES, plan, render
-from pyoa.render.scene import MESH_FILE_FACTOR, MESH_TRIANGLE_BYTES, SceneError, bundled, load
+from pyoa.render.scene import MESH_FILE_FACTOR, MESH_KEPT_BYTES, MESH_TRIANGLE_BYTES, SceneError, bundled, load
 from pyoa.render.state import write_state
 from pyoa.units import format_bytes
 
@@ -384,6 +384,30 @@ def test_the_render_plan_counts_the_scene(tmp_path):
                                          rf"of 2\.0 MiB; render a scene of fewer triangles \(its "
                                          rf"{len(scene.triangles)} triangles take {traced} to trace\)"):
         render(scene, sampler="sobol", spp=1, width=8, height=8, max_bytes="2M")
+
+
+def test_meshes_loaded_before_count_what_they_keep(tmp_path):
+    """Four meshes of 2048 triangles load under a limit of the last one at
+    MESH_TRIANGLE_BYTES plus the three before it at MESH_KEPT_BYTES (their
+    arrays, not a parse: only one mesh is parsed at a time), though all four
+    at 1 KiB need more; one byte less is refused, naming both counts. Every
+    triangle loaded so far used to count 1 KiB: ten 1M-triangle meshes were
+    refused under the default limit of a 16 GB machine (8 GiB)."""
+    triangles = grid_ply(tmp_path / "grid32.ply", 32)
+    data = json.loads(open(bundled()["cornell"]).read())
+    for k in range(4):
+        data["shapes"].append({"type": "mesh", "file": "grid32.ply", "material": "white",
+                               "to_world": [[0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 0.5, 0.1 * k], [0, 0, 0, 1]]})
+    path = tmp_path / "meshes.json"
+    path.write_text(json.dumps(data))
+    plan = triangles * MESH_TRIANGLE_BYTES + 3 * triangles * MESH_KEPT_BYTES
+    assert 4 * triangles * MESH_TRIANGLE_BYTES > plan
+    assert len(load(path, max_bytes=plan).triangles) == len(load("cornell").triangles) + 4 * triangles
+    need, limit = (re.escape(format_bytes(b)) for b in (plan, plan - 1))
+    with pytest.raises(SceneError, match=rf"meshes\.json: shapes\[11\]\.file: loading mesh 'grid32\.ply' of "
+                                         rf"{triangles} triangles \(and the {3 * triangles} triangles of the meshes "
+                                         rf"before it\) needs {need}, over the memory limit of {limit}"):
+        load(path, max_bytes=plan - 1)
 
 
 def test_running_out_of_memory_is_one_line(tmp_path):

@@ -107,7 +107,7 @@ def russian_roulette(br, bg, bb, key, sample_index, depth):
 
 
 @njit(**_JIT)
-def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
+def shade(n, depth, max_depth, mis, rr_depth, reach, growth,
           verts, normals, areas, material, emission, kinds, colors, alphas, em, em_cdf, em_prob,
           x, light_u, light_v, bsdf_u, bsdf_v, sample_index, rr_key,
           lane, o, d, beta, prev_pdf, prev_delta, prim, t, radiance,
@@ -120,9 +120,10 @@ def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
     to the front of ``lane, o, d, beta, prev_pdf, prev_delta`` with their new
     rays. Returns ``(live lanes, shadow rays)``. ``light_u`` and the other
     column indices are -1 where the layout has no such dimension. Hit points
-    are moved onto their triangle's plane (:func:`to_plane`, ``planes``: the
+    are moved onto their triangle's plane (:func:`to_plane`, ``normals``: the
     unit normals of the triangles as traced) and new rays leave them by
-    :func:`offset_distance` (``sizes``: the longest edge of each triangle).
+    :func:`offset_distance` (``reach``, ``growth``: as
+    ``integrator.triangle_reach``).
     """
     live, shadows = 0, 0
     for i in range(n):
@@ -134,7 +135,7 @@ def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
         ti = t[i]
         px, py, pz = to_plane(o[i, 0] + ti * dx, o[i, 1] + ti * dy, o[i, 2] + ti * dz,
                               verts[tri, 0, 0], verts[tri, 0, 1], verts[tri, 0, 2],
-                              planes[tri, 0], planes[tri, 1], planes[tri, 2])
+                              normals[tri, 0], normals[tri, 1], normals[tri, 2])
         nx, ny, nz = normals[tri, 0], normals[tri, 1], normals[tri, 2]
         br, bg, bb = beta[i, 0], beta[i, 1], beta[i, 2]
         # emission seen by this ray (emitters are one-sided)
@@ -148,7 +149,7 @@ def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
             radiance[li, 2] += bb * eb * w
         if depth == max_depth:
             continue
-        eps = offset_distance(px, py, pz, nx, ny, nz, sizes[tri])  # new rays leave p this far
+        eps = offset_distance(px, py, pz, nx, ny, nz, reach[tri])  # new rays leave p this far
         # shading frame facing the incoming ray (two-sided surfaces)
         if nx * dx + ny * dy + nz * dz > 0:
             sx, sy, sz = -nx, -ny, -nz
@@ -176,10 +177,11 @@ def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
             pdf_l = pdf_area * dist * dist / max(cos_q, 1e-12)
             if cos_q > 0 and (fr > 0 or fg > 0 or fb > 0):
                 # from p + eps n to q + eps_q n_q, each moved off its surface
-                # by its own float32 error bound (q's: the end of a segment of length dist)
+                # by its own float32 error bound (q's: the end of a segment of
+                # length dist), not shortened further (as the reference)
                 side = eps if wx * sx + wy * sy + wz * sz > 0 else -eps
                 ax, ay, az = px + side * sx, py + side * sy, pz + side * sz
-                eq = offset_distance(qx, qy, qz, mx, my, mz, dist + sizes[etri])
+                eq = offset_distance(qx, qy, qz, mx, my, mz, dist * growth[etri] + reach[etri])
                 gx, gy, gz = qx + eq * mx - ax, qy + eq * my - ay, qz + eq * mz - az
                 seg = math.sqrt(gx * gx + gy * gy + gz * gz)
                 sn = max(seg, 1e-12)
@@ -187,7 +189,7 @@ def shade(n, depth, max_depth, mis, rr_depth, sizes, planes,
                 f = wl / pdf_l
                 sh_o[shadows, 0], sh_o[shadows, 1], sh_o[shadows, 2] = ax, ay, az
                 sh_d[shadows, 0], sh_d[shadows, 1], sh_d[shadows, 2] = gx / sn, gy / sn, gz / sn
-                sh_dist[shadows] = seg * (1 - 1e-4)
+                sh_dist[shadows] = seg
                 sh_lane[shadows] = li
                 sh_c[shadows, 0] = br * fr * emission[etri, 0] * f
                 sh_c[shadows, 1] = bg * fg * emission[etri, 1] * f
@@ -313,7 +315,7 @@ class CompiledIntegrator(reference.Integrator):
                 cols[:2] = L.pair(f"light{depth}")
                 if f"bsdf{depth}.u" in L:
                     cols[2:] = L.pair(f"bsdf{depth}")
-            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self.sizes, self.planes,
+            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self.reach, self.growth,
                                   self._verts, self._normals, self._areas, self._material, self._emission,
                                   kinds, colors, alphas, *self._em,
                                   x, *cols, sample_index, rr_key,
