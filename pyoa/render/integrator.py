@@ -53,35 +53,38 @@ RR_KEY = 0x7FEB352D
 #: float32 vertices, shadow rays are not shortened, triangles flat in float32
 #: are dropped; 1: offsets of 1e-4 of the scene's largest coordinate.
 RENDERER_VERSION = 2
-# The two factors below were checked with a stress test of Embree's answers
-# (robust mode, as embreex and pyoa.render.embree build their scenes; both
-# gave the same counts): new rays leaving random points of one triangle
-# (counted when they hit it), and shadow rays from points in front of a light
-# triangle to random points of it (counted when occluded, the light alone in
-# the scene); triangles 1e-3 to 1e5 across at 0 to 1e7 from the origin
-# (within the loader's limits), axis-aligned, tilted by 1e-6 or 1e-3 radian
-# or in random orientations, well shaped, needles and caps (all three edges
-# long) of heights 1e-2 to 1e-6 of their length; shadow rays 1e-3 to 1e2
-# times the light's size; 20 000 rays per case, half of them within 0.1
-# radian of grazing: 1.55e7 new rays and 3.6e6 shadow rays in all. Earlier
-# the Cornell box translated by up to 1e5 and scaled from 1e-3 to 1e8.
+# The two factors below are checked by benchmarks/offset_stress.py (results:
+# benchmarks/results/offset-stress.md), a stress test of Embree's answers
+# through pyoa.render.embree with this module's own offset functions (robust
+# mode, as embreex and pyoa.render.embree build their scenes; embreex gives
+# the same counts): new rays leaving random points of one triangle (counted
+# when they hit it), and shadow rays from points in front of a light triangle
+# to random points of it (counted when occluded, the light alone in the
+# scene); triangles 1e-3 to 1e5 across at 0 to 1e7 from the origin (within
+# the loader's limits), axis-aligned, tilted by 1e-6 or 1e-3 radian or in
+# random orientations, well shaped, needles and caps (all three edges long)
+# of heights 1e-2 to 1e-6 of their length; shadow rays 1e-3 to 1e2 times the
+# light's size; half the rays within 0.1 radian of grazing: 4.66e7 new rays
+# and 3.38e7 shadow rays in all (2026-11-27, Intel Xeon 6/207).
 
 #: Bound, relative to a coordinate, on the float32 rounding of ray origins
-#: (:func:`offset_distance`): half an ulp is at most 2^-24 of it; 2 * 2^-24 is
-#: the smallest factor without self-intersections in the stress test (1 *
-#: 2^-24 left 5e-5 of the new rays at 1e5), so 4 * 2^-24 leaves a margin of 2.
+#: (:func:`offset_distance`): half an ulp is at most 2^-24 of it. In the
+#: stress test 1 * 2^-24 is the smallest factor without self-intersections or
+#: false occlusion (0.5 * 2^-24 lets 24 % of the new rays round back onto
+#: axis-aligned planes), so 4 * 2^-24 leaves a margin of 4.
 ORIGIN_ERROR = 4 * 2.0**-24
 #: Bound on the error, along the normal, of Embree's float32 ray-triangle
 #: test, relative to the reach of the triangle (:func:`triangle_reach`) and,
 #: for the light end of a shadow ray, to the segment's length times the
-#: triangle's growth (:func:`offset_distance`). In the stress test 2 * 2^-24
-#: is the smallest factor without self-intersections (1 * 2^-24 left 67 of
-#: the 1.55e7 new rays), 4 * 2^-24 the smallest without false occlusion (2 *
-#: 2^-24 left 45 of the 3.6e6 shadow rays), so 16 * 2^-24 leaves margins of
-#: 8 and 4. With the origin's rounding alone (and the reach's last term) 2.1 %
-#: of the new rays hit the triangle they left, in tilted triangles; with the
-#: longest edge as the reach (as before) 0.5 %, all from caps, and 3727 shadow
-#: rays were occluded by their light even with the segment shortened by 1e-4.
+#: triangle's growth (:func:`offset_distance`). In the stress test 4 * 2^-24
+#: is the smallest factor without self-intersections (2 * 2^-24 left 9 of the
+#: 4.66e7 new rays, all in one cap 1e-6 high) or false occlusion (2 * 2^-24
+#: left 378 of the 3.38e7 shadow rays), so 16 * 2^-24 leaves a margin of 4.
+#: With the origin's rounding alone (and the reach's last term) 2.1 % of the
+#: new rays hit the triangle they left, in tilted triangles; with the longest
+#: edge as the reach (before issue 33's review) 0.38 %, all from caps, and
+#: 14 034 shadow rays were occluded by their light even with the segment
+#: shortened by 1e-4.
 TEST_ERROR = 16 * 2.0**-24
 
 
