@@ -23,6 +23,7 @@ import threading
 import warnings
 
 from ._numpy.backend import NumpyBackend
+from .catalogue_types import check_choice
 
 BACKENDS = ("opencl", "numpy")
 ENV_BACKEND = "PYOA_BACKEND"
@@ -112,19 +113,7 @@ def backend_name(backend: str | None = None) -> str | None:
         A name (of the argument or of the environment variable, which the
         message names) that is not one of :data:`BACKENDS`.
     """
-    if backend is None:
-        backend = os.environ.get(ENV_BACKEND) or None
-        origin, automatic = f"${ENV_BACKEND}", "unset it"
-    else:
-        origin, automatic = "backend", "None"
-    if backend is None:
-        return None
-    if not isinstance(backend, str):
-        raise TypeError(f"backend must be a str or None, got {type(backend).__name__}")
-    name = backend.strip().lower()
-    if name not in BACKENDS:
-        raise ValueError(f"unknown {origin} {name!r}; valid: {', '.join(BACKENDS)} (or {automatic} for automatic)")
-    return name
+    return check_choice(backend, ENV_BACKEND, BACKENDS, None)
 
 
 def _check_selector(device) -> None:

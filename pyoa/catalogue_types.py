@@ -37,6 +37,7 @@ constructions form (``s*s``, ``A_ik*s + A_ij + 1``, ``s**t``) stays below
 from __future__ import annotations
 
 import numbers
+import os
 import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -57,6 +58,29 @@ MAX_SPP = 2**24
 MAX_DIMS = 2**20
 #: Largest user seed, pixel index: both are uint32 (docs/spec.md section 3).
 MAX_UINT32 = 2**32 - 1
+
+
+def check_choice(value, env: str, valid, default: str | None) -> str | None:
+    """The option that ``value`` names, else ``$env``, else ``default``: a
+    str of ``valid``, checked and in lower case (TypeError for a non-str
+    argument, ValueError naming the argument, or the variable, and the valid
+    names). The one rule of pyoa's options that an environment variable may
+    set (``backend``/``$PYOA_BACKEND``, ``shading``/``$PYOA_SHADING``)."""
+    name = env.removeprefix("PYOA_").lower()
+    if value is None:
+        value = os.environ.get(env) or None
+        origin, unset = f"${env}", "unset it"
+    else:
+        origin, unset = name, "None"
+    if value is None:
+        return default
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a str or None, got {type(value).__name__}")
+    chosen = value.strip().lower()
+    if chosen not in valid:
+        suffix = f" (or {unset} for automatic)" if default is None else f" (or {unset} for {default})"
+        raise ValueError(f"unknown {origin} {value.strip()!r}; valid: {', '.join(valid)}{suffix}")
+    return chosen
 
 
 def check_int(name: str, value, lo: int | None = None, hi: int | None = None, why: str = "") -> int:

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import catalogue
-from ..catalogue_types import MAX_UINT32
+from ..catalogue_types import MAX_UINT32, check_choice
 from ..samplers import ENV_MAX_BYTES, default_max_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
 from ..units import format_bytes
@@ -56,15 +56,7 @@ ENV_SHADING = "PYOA_SHADING"
 
 def resolve_shading(shading: str | None) -> str:
     """The shading to use: ``shading``, else ``$PYOA_SHADING``, else ``"numba"``."""
-    origin = "shading"
-    if shading is None:
-        shading, origin = os.environ.get(ENV_SHADING) or "numba", f"${ENV_SHADING}"
-    if not isinstance(shading, str):
-        raise TypeError(f"shading must be a str or None, got {type(shading).__name__}")
-    name = shading.strip().lower()
-    if name not in SHADINGS:
-        raise ValueError(f"unknown {origin} {shading!r}; valid: {', '.join(SHADINGS)}")
-    return name
+    return check_choice(shading, ENV_SHADING, SHADINGS, "numba")
 
 
 @dataclass
