@@ -304,6 +304,20 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
               file=sys.stderr if file is None else file)
 
 
+def _stdout_closed() -> bool:
+    """Whether standard output's reader has gone (a BrokenPipeError may also
+    come from elsewhere: a socket, a subprocess)."""
+    import select
+
+    try:
+        poll = select.poll()
+        poll.register(sys.stdout.fileno(), select.POLLOUT)
+        # a pipe (or socket) whose reader has closed polls as an error
+        return any(events & select.POLLERR for _fd, events in poll.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), no file descriptor
+        return False
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
     args = ap.parse_args(argv)
@@ -311,6 +325,14 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning
             return args.func(args)
+    except BrokenPipeError as exc:
+        if not _stdout_closed():
+            ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
+        # the reader of our output is gone (`pyoa spp bose | head`): stop quietly, as a C tool that SIGPIPE
+        # ends, with its status 128 + SIGPIPE; stdout goes to /dev/null so that Python's flush at exit
+        # does not fail again (https://docs.python.org/3/library/signal.html#note-on-sigpipe)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 128 + 13
     except (ValueError, TypeError, OSError, BackendUnavailable, TasksLost) as exc:  # ClusterUnavailable: ValueError
         # OSError: an output that cannot be written (pyoa.atomic names the
         # user's path), a missing input file; a one-line message, not a traceback

@@ -193,3 +193,14 @@ def test_csv_written_in_blocks_equals_one_block(tmp_path, monkeypatch):
     assert cli.main(args + [str(tmp_path / "blocks.csv")]) == 0
     one = (tmp_path / "one.csv").read_text()
     assert (tmp_path / "blocks.csv").read_text() == one and one.count("\n") == 1 + 7 * 27
+
+
+@pytest.mark.parametrize("argv", [["spp", "bose"], ["samplers"]])
+def test_a_closed_pipe_ends_the_command_quietly(argv):
+    """``pyoa spp bose | head``: the reader closes the pipe (here before the
+    command writes at all); the command stops quietly with the status of a
+    tool that SIGPIPE ends (128 + 13), not with an error about Errno 32."""
+    proc = subprocess.Popen([sys.executable, "-m", "pyoa", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 141 and err == b"", (proc.returncode, err)
