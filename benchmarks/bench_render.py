@@ -48,7 +48,6 @@ import statistics
 import subprocess
 import sys
 import time
-import types
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
@@ -155,36 +154,77 @@ def profile_parts(scene, args, shading: str) -> dict:
             "shares": {k: v / res.seconds for k, v in parts.items()}}
 
 
+def record_rays(scene, args, size) -> tuple[list, int]:
+    """The rays of a ``size`` render of ``scene`` with the compiled shading:
+    ``(calls, paths)``, ``calls`` a list of ``("hit", o, d, None)`` and
+    ``("occ", o, d, dist)`` wavefronts in the order they are traced. The
+    render runs the compiled integrator's own stages (camera rays,
+    ``shade``, ``add_visible``) one wavefront at a time from Python, as
+    ``render_paths`` runs them in one compiled call, and copies each
+    wavefront's rays before tracing them."""
+    from pyoa.render import embree
+    from pyoa.render.compiled import integrator as ci
+    from pyoa.render.integrator import U32, hash_pair, RR_KEY
+    from pyoa.render.camera import filter_offsets
+
+    res = render(scene, sampler=args.sampler, spp=args.spp, width=size[0], height=size[1],
+                 max_depth=args.max_depth, threads=1, shading="numba", pixels=range(0, 1))
+    integ = res.integrator[0]
+    smp_kw = dict(sampler=args.sampler, spp=args.spp, width=size[0], height=size[1], max_depth=args.max_depth)
+    from pyoa.render.render import plan
+
+    p = plan(scene, **smp_kw)
+    L, n_pix = integ.layout, size[0] * size[1]
+    x = np.ascontiguousarray(p.sampler.generate(pixels=range(n_pix)).reshape(n_pix * p.sampler.spp, -1))
+    pixel = np.repeat(np.arange(n_pix), p.sampler.spp)
+    sample = np.tile(np.arange(p.sampler.spp), n_pix).astype(np.int64)
+    u = np.ascontiguousarray(filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), integ.filter))
+    lens = x[:, list(L.pair("lens"))].astype(np.float64) if L.lens else np.zeros((0, 2))
+    shutter = x[:, L.index("time")].astype(np.float64) if L.time else np.zeros(0)
+    rr_key = hash_pair(U32(p.sampler.seed), pixel.astype(U32), RR_KEY).astype(np.int64)
+    radiance = np.zeros((len(pixel), 3))
+    tr, sc, cam, ps = integ._tracer, integ._scene, integ._camera, integ._settings
+    calls = []
+    size_w = integ.wavefront
+    w = ci.new_wavefront(size_w)
+    for start in range(0, len(pixel), size_w):
+        stop = min(start + size_w, len(pixel))
+        m = stop - start
+        ci.camera_rays(pixel[start:stop], u[start:stop], lens[start:stop] if len(lens) else lens,
+                       shutter[start:stop] if len(shutter) else shutter, cam.width, cam.height, cam.tan_x,
+                       cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, w.o, w.d)
+        w.lane[:m] = np.arange(start, stop)
+        w.beta[:m] = 1.0
+        w.prev_pdf[:m] = 0.0
+        w.prev_delta[:m] = True
+        live = m
+        for depth in range(1, ps.max_depth + 1):
+            if live == 0:
+                break
+            calls.append(("hit", w.o[:live].copy(), w.d[:live].copy(), None))
+            embree.intersect(tr.scene, tr.hit, tr.packet, w.o[:live], w.d[:live], w.prim, w.t)
+            live, shadows = ci.shade(live, depth, sc, ps, x, sample, rr_key, w, radiance)
+            if shadows:
+                calls.append(("occ", w.sh_o[:shadows].copy(), w.sh_d[:shadows].copy(), w.sh_dist[:shadows].copy()))
+                embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],
+                                w.sh_dist[:shadows], w.free)
+            ci.add_visible(shadows, w, radiance)
+    return calls, len(pixel)
+
+
 def embree_floor(scene, args, size=(64, 64)) -> dict:
-    """The tracing path pyoa ships (Embree packets called from numba) alone:
-    the rays of a ``size`` render of the same scene, sampler, spp and depth
-    are recorded, then replayed on two threads (each half of the wavefronts),
-    median of 3. ``paths_per_s`` is the rate at the render's own rays per
-    path: what the renderer would reach if shading, sampling and bookkeeping
-    were free."""
+    """The tracing path pyoa ships (Embree packets called from numba, the
+    scene built as the renderer builds it) alone: the rays of a ``size``
+    render of the same scene, sampler, spp and depth (:func:`record_rays`)
+    replayed on two threads (each half of the wavefronts), median of 3.
+    ``paths_per_s`` is the rate at the render's own rays per path: what the
+    renderer would reach if shading, sampling and bookkeeping were free."""
     from concurrent.futures import ThreadPoolExecutor
 
     from pyoa.render import embree
     from pyoa.render.compiled import integrator as ci
 
-    calls = []
-    real_i, real_o = embree.intersect, embree.occluded
-
-    def intersect(sc, fn, width, o, d, prim, t):
-        calls.append(("hit", o.copy(), d.copy(), None))
-        return real_i(sc, fn, width, o, d, prim, t)
-
-    def occluded(sc, fn, width, o, d, dist, free):
-        calls.append(("occ", o.copy(), d.copy(), dist.copy()))
-        return real_o(sc, fn, width, o, d, dist, free)
-
-    # the compiled integrator's view of the embree module, with recording queries
-    ci.embree = types.SimpleNamespace(**{**vars(embree), "intersect": intersect, "occluded": occluded})
-    try:
-        res = render(scene, sampler=args.sampler, spp=args.spp, width=size[0], height=size[1],
-                     max_depth=args.max_depth, threads=1, shading="numba")
-    finally:
-        ci.embree = embree
+    calls, paths = record_rays(scene, args, size)
     width = ci.packet_width()
     rtc = embree.Scene(scene.triangles)
     fn_hit, fn_occ = embree.query_addresses(width)
@@ -205,7 +245,7 @@ def embree_floor(scene, args, size=(64, 64)) -> dict:
             list(pool.map(replay, [calls[0::2], calls[1::2]]))
             times.append(time.perf_counter() - t0)
     med = statistics.median(times)
-    rays_per_path = rays / res.stats.paths
+    rays_per_path = rays / paths
     return {"size": list(size), "rays": rays, "packet": width, "threads": 2, "times_s": times,
             "rays_per_s": rays / med, "rays_per_path": rays_per_path, "paths_per_s": rays / med / rays_per_path}
 

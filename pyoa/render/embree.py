@@ -131,26 +131,36 @@ class Scene:
     triangles : array_like
         ``(T, 3, 3)`` world-space vertices; they are converted to float32
         exactly as ``embreex`` does.
+    robust : bool
+        Embree's robust mode (``RTC_SCENE_FLAG_ROBUST``: a conservative
+        traversal and watertight triangle test), as ``embreex`` builds its
+        scenes: the default, and what the renderer traces with. Without it
+        tracing is 1.4-1.6x faster, but rays through a shared edge can pass
+        between its two triangles: about 2 % of the rays aimed exactly at
+        the seams of the bundled scenes leak, against none in robust mode
+        (``tests/render/test_embree.py``; docs/performance.md, "Tracing").
 
-    ``handle`` is the ``RTCScene`` as an integer, for the compiled queries.
-    The scene keeps its device and buffers alive until :meth:`close` (or
-    garbage collection).
+    The BVH is built on one thread (the device's ``threads=1``), so the
+    same triangles give the same BVH, and every ray the same hit, in every
+    process (a multi-threaded build may split differently from run to run,
+    and without robust mode a ray through a shared edge may then hit the
+    other triangle). ``handle`` is the ``RTCScene`` as an integer, for the
+    compiled queries. The scene keeps its device and buffers alive until
+    :meth:`close` (or garbage collection).
     """
 
-    def __init__(self, triangles):
+    def __init__(self, triangles, *, robust: bool = True):
         lib = library()
         tris = np.ascontiguousarray(triangles, dtype=np.float32).reshape(-1, 3, 3)
         if len(tris) == 0:
             raise ValueError("an Embree scene needs at least one triangle")
         self._lib = lib
-        self._device = lib.rtcNewDevice(None)
+        self._device = lib.rtcNewDevice(b"threads=1")
         if not self._device:
             raise EmbreeUnavailable(f"rtcNewDevice failed (Embree error {lib.rtcGetDeviceError(None)})")
         try:
             self._scene = lib.rtcNewScene(self._device)
-            # Robust traversal, as embreex's scenes: the same hits as the NumPy
-            # reference's (tested), also at ties between coplanar triangles.
-            lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST)
+            lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST if robust else 0)
             geom = lib.rtcNewGeometry(self._device, _GEOMETRY_TYPE_TRIANGLE)
             vb = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3, 12, 3 * len(tris))
             ib = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3, 12, len(tris))
@@ -175,6 +185,7 @@ class Scene:
             raise
         self.handle = int(self._scene)
         self.triangles = len(tris)
+        self.robust = bool(robust)
 
     def close(self) -> None:
         """Release the scene and its device (idempotent)."""

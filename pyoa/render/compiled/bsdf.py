@@ -16,7 +16,7 @@ import math
 from numba import njit
 
 from ..bsdf import ALPHA_MIN, DIFFUSE, GGX, MIRROR
-from .geometry import concentric_disk
+from .geometry import concentric_disk, cos_sin_turn
 
 _TINY = 1e-300
 #: error_model="numpy": divisions follow IEEE (as the NumPy reference's do)
@@ -70,9 +70,9 @@ def ggx_sample_vndf(ox, oy, oz, alpha, u0, u1):
     t2y = vz * t1x - vx * t1z
     t2z = vx * t1y - vy * t1x
     r = math.sqrt(u0)
-    phi = 2.0 * math.pi * u1
-    p1 = r * math.cos(phi)
-    p2 = r * math.sin(phi)
+    c, s_ = cos_sin_turn(u1)  # of the angle 2 pi u1
+    p1 = r * c
+    p2 = r * s_
     s = 0.5 * (1.0 + vz)
     p2 = (1.0 - s) * math.sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2
     p3 = math.sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2))

@@ -1,27 +1,41 @@
-"""The wavefront path tracer of :mod:`pyoa.render.integrator`, its shading
-compiled with numba and Embree called from the compiled loops.
+"""The wavefront path tracer of :mod:`pyoa.render.integrator`, compiled with
+numba, Embree called from the compiled loop.
 
 Same estimator, same dimension layout and the same guards as the NumPy
 reference (read its docstring): camera rays (box or Gaussian filter, thin
 lens, camera motion), emission seen by a ray with its MIS weight (power
 heuristic), next-event estimation by emitter power, BSDF sampling, Russian
-roulette from depth :data:`~pyoa.render.integrator.RR_DEPTH`. Each bounce is
-three compiled calls over the whole wavefront: closest hits (Embree packets),
-``shade`` (emission, the next-event candidate with its shadow ray, the BSDF
-sample, roulette and the compaction of live lanes), then the shadow rays
-(Embree packets) and ``add_visible``. Every call releases the GIL, so the
-renderer's worker threads keep both cores busy; a lane's result depends only
-on its own row of sampler values, so the image does not depend on the batch
-size, the packet width or the number of threads.
+roulette from depth :data:`~pyoa.render.integrator.RR_DEPTH`.
+
+A batch of camera paths is one call of :func:`render_paths`, which releases
+the GIL and never returns to Python until the batch is done: it takes the
+paths a wavefront of :data:`WAVEFRONT` lanes at a time (small enough for the
+lanes' state to stay in the CPU's caches), makes their camera rays, and for
+each bounce traces the closest hits (Embree packets), shades them
+(:func:`shade`: emission, the next-event candidate with its shadow ray, the
+BSDF sample, roulette and the compaction of live lanes), traces the shadow
+rays and adds what they carry. The renderer's worker threads run batches
+side by side on every core; a lane's result depends only on its own row of
+sampler values, so the image does not depend on the batch size, the
+wavefront size, the packet width or the number of threads.
+
+The scene, the camera, the path settings and the wavefront's state are
+passed as named tuples (:class:`SceneData`, :class:`CameraData`,
+:class:`PathSettings`, :class:`Wavefront`), which numba compiles to plain
+structures.
 """
 
 from __future__ import annotations
 
+import ctypes
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 from .. import embree
 from .. import integrator as reference
@@ -106,25 +120,112 @@ def russian_roulette(br, bg, bb, key, sample_index, depth):
     return False, br, bg, bb
 
 
+class SceneData(NamedTuple):
+    """The scene's arrays as the compiled loop reads them (built by
+    :meth:`CompiledIntegrator.__init__` from :class:`pyoa.render.scene.Scene`,
+    its :class:`~pyoa.render.emitters.Emitters` and
+    :func:`~pyoa.render.integrator.triangle_reach`)."""
+
+    verts: np.ndarray  # (T, 3, 3) float64 copies of the float32 vertices Embree traces
+    normals: np.ndarray  # (T, 3) unit normals of the triangles as traced
+    areas: np.ndarray  # (T,)
+    material: np.ndarray  # (T,) int64 material of each triangle
+    emission: np.ndarray  # (T, 3) radiance emitted (front side)
+    kinds: np.ndarray  # (M,) int64 BSDF kind of each material (pyoa.render.bsdf)
+    colors: np.ndarray  # (M, 3)
+    alphas: np.ndarray  # (M,) GGX roughness
+    em: np.ndarray  # (E,) int64 emitting triangles (Emitters.index)
+    em_cdf: np.ndarray  # (E,) their power CDF (Emitters.cdf)
+    em_prob: np.ndarray  # (T,) probability of each triangle's choice (Emitters.prob)
+    reach: np.ndarray  # (T,) triangle_reach: Embree's error grows with it ...
+    growth: np.ndarray  # (T,) ... and, at a shadow segment's end, with its length times this
+
+
+class CameraData(NamedTuple):
+    """The camera (:class:`pyoa.render.camera.PerspectiveCamera`) for :func:`camera_rays`."""
+
+    width: int
+    height: int
+    tan_x: float
+    tan_y: float
+    rot: np.ndarray  # (3, 3) camera to world
+    pos: np.ndarray  # (3,)
+    aperture: float
+    focus: float
+    motion: np.ndarray  # (3,)
+
+
+class PathSettings(NamedTuple):
+    """What a path does and which sampler columns feed it (:class:`pyoa.render.layout.Layout`)."""
+
+    max_depth: int
+    mis: bool
+    rr_depth: int
+    columns: np.ndarray  # (max_depth + 1, 4) int64: light u, v, bsdf u, v of each depth; -1 where none
+
+
+class Tracer(NamedTuple):
+    """An Embree scene and its queries, as integers (:mod:`pyoa.render.embree`)."""
+
+    scene: int  # RTCScene
+    hit: int  # address of rtcIntersect<packet>
+    occluded: int  # address of rtcOccluded<packet>
+    packet: int
+
+
+class Wavefront(NamedTuple):
+    """The state of up to ``len(lane)`` live paths, compacted to the front
+    after every bounce, and the shadow rays of the current bounce."""
+
+    lane: np.ndarray  # (W,) int64 path (row of x) of each live entry
+    o: np.ndarray  # (W, 3) ray origins
+    d: np.ndarray  # (W, 3) unit ray directions
+    beta: np.ndarray  # (W, 3) path throughput
+    prev_pdf: np.ndarray  # (W,) solid-angle pdf of the BSDF sample that made the ray
+    prev_delta: np.ndarray  # (W,) bool: that sample was a delta lobe (or the camera's)
+    prim: np.ndarray  # (W,) int64 closest hit (-1: none)
+    t: np.ndarray  # (W,) its distance
+    sh_o: np.ndarray  # (W, 3) shadow rays
+    sh_d: np.ndarray
+    sh_dist: np.ndarray
+    sh_lane: np.ndarray  # (W,) int64 path each shadow ray belongs to
+    sh_c: np.ndarray  # (W, 3) what it carries if it reaches its emitter
+    free: np.ndarray  # (W,) bool: nothing blocks it
+
+
 @njit(**_JIT)
-def shade(n, depth, max_depth, mis, rr_depth, reach, growth,
-          verts, normals, areas, material, emission, kinds, colors, alphas, em, em_cdf, em_prob,
-          x, light_u, light_v, bsdf_u, bsdf_v, sample_index, rr_key,
-          lane, o, d, beta, prev_pdf, prev_delta, prim, t, radiance,
-          sh_o, sh_d, sh_dist, sh_lane, sh_c):
-    """One bounce of ``n`` live lanes whose closest hits are ``prim``/``t``.
+def new_wavefront(size):
+    """Empty wavefront buffers for ``size`` lanes."""
+    return Wavefront(np.empty(size, np.int64), np.empty((size, 3)), np.empty((size, 3)), np.empty((size, 3)),
+                     np.empty(size), np.empty(size, np.bool_), np.empty(size, np.int64), np.empty(size),
+                     np.empty((size, 3)), np.empty((size, 3)), np.empty(size), np.empty(size, np.int64),
+                     np.empty((size, 3)), np.empty(size, np.bool_))
+
+
+@njit(**_JIT)
+def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance):
+    """One bounce of the ``n`` live lanes of the wavefront ``w``, whose
+    closest hits are ``w.prim``/``w.t``.
 
     Adds the emission each ray sees (MIS-weighted) to ``radiance``; writes
-    the next-event shadow rays and their contributions (``sh_*``); samples the
-    BSDF, plays Russian roulette and compacts the surviving lanes, in place,
-    to the front of ``lane, o, d, beta, prev_pdf, prev_delta`` with their new
-    rays. Returns ``(live lanes, shadow rays)``. ``light_u`` and the other
-    column indices are -1 where the layout has no such dimension. Hit points
-    are moved onto their triangle's plane (:func:`to_plane`, ``normals``: the
-    unit normals of the triangles as traced) and new rays leave them by
-    :func:`offset_distance` (``reach``, ``growth``: as
-    ``integrator.triangle_reach``).
+    the next-event shadow rays and their contributions (``w.sh_*``); samples
+    the BSDF, plays Russian roulette and compacts the surviving lanes, in
+    place, to the front of ``w.lane, o, d, beta, prev_pdf, prev_delta`` with
+    their new rays. Returns ``(live lanes, shadow rays)``. The sampler
+    columns of this depth are ``ps.columns[depth]`` (-1 where the layout has
+    no such dimension). Hit points are moved onto their triangle's plane
+    (:func:`to_plane`, ``sc.normals``: the unit normals of the triangles as
+    traced) and new rays leave them by :func:`offset_distance` (``sc.reach``,
+    ``sc.growth``: as ``integrator.triangle_reach``).
     """
+    max_depth, mis, rr_depth = ps.max_depth, ps.mis, ps.rr_depth
+    light_u, light_v = ps.columns[depth, 0], ps.columns[depth, 1]
+    bsdf_u, bsdf_v = ps.columns[depth, 2], ps.columns[depth, 3]
+    verts, normals, areas, material, emission = sc.verts, sc.normals, sc.areas, sc.material, sc.emission
+    kinds, colors, alphas, em, em_cdf, em_prob = sc.kinds, sc.colors, sc.alphas, sc.em, sc.em_cdf, sc.em_prob
+    reach, growth = sc.reach, sc.growth
+    lane, o, d, beta, prev_pdf, prev_delta, prim, t = w.lane, w.o, w.d, w.beta, w.prev_pdf, w.prev_delta, w.prim, w.t
+    sh_o, sh_d, sh_dist, sh_lane, sh_c = w.sh_o, w.sh_d, w.sh_dist, w.sh_lane, w.sh_c
     live, shadows = 0, 0
     for i in range(n):
         tri = prim[i]
@@ -220,14 +321,105 @@ def shade(n, depth, max_depth, mis, rr_depth, reach, growth,
 
 
 @njit(**_JIT)
-def add_visible(m, free, sh_lane, sh_c, radiance):
+def add_visible(m, w, radiance):
     """Add the contributions of the shadow rays that reached their emitter."""
     for k in range(m):
-        if free[k]:
-            li = sh_lane[k]
-            radiance[li, 0] += sh_c[k, 0]
-            radiance[li, 1] += sh_c[k, 1]
-            radiance[li, 2] += sh_c[k, 2]
+        if w.free[k]:
+            li = w.sh_lane[k]
+            radiance[li, 0] += w.sh_c[k, 0]
+            radiance[li, 1] += w.sh_c[k, 1]
+            radiance[li, 2] += w.sh_c[k, 2]
+
+
+#: Lanes of a wavefront: the paths of a batch are traced this many at a time,
+#: so that their state (about 300 bytes a lane) stays in the CPU's caches
+#: (docs/performance.md, "Rendering": 128 to 1,024 lanes were 5-15 % faster than
+#: 4,096 to 65,536).
+WAVEFRONT = 512
+#: Stages :func:`render_paths` times (its ``spent`` array, in this order).
+STAGES = ("camera", "embree", "shading")
+_CLOCK_MONOTONIC = 1
+
+
+@intrinsic
+def _clock_gettime(typingctx, fn, clock, ts):
+    """``((int (*)(int, void *)) fn)(clock, ts)``: the C library's ``clock_gettime``."""
+    sig = types.int32(types.uint64, types.int32, types.uint64)
+
+    def codegen(context, builder, signature, args):
+        i32, ptr = ir.IntType(32), ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(i32, [i32, ptr])
+        f = builder.inttoptr(args[0], fnty.as_pointer())
+        return builder.call(f, [args[1], builder.inttoptr(args[2], ptr)])
+
+    return sig, codegen
+
+
+def clock_address() -> int:
+    """Address of the C library's ``clock_gettime`` (passed as an integer,
+    so that numba's on-disk cache stays valid across processes)."""
+    return ctypes.cast(ctypes.CDLL(None).clock_gettime, ctypes.c_void_p).value
+
+
+@njit(**_INLINE)
+def _now(clock, ts):
+    """Monotonic seconds (``ts``: an int64[2] timespec buffer)."""
+    _clock_gettime(clock, np.int32(_CLOCK_MONOTONIC), np.uint64(ts.ctypes.data))
+    return ts[0] + ts[1] * 1e-9
+
+
+@njit(**_JIT)
+def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, lens, shutter, rr_key, radiance, spent, clock,
+                 wavefront):
+    """Radiance of the camera paths ``(pixel[i], sample_index[i])`` whose
+    sampler rows are ``x[i]``, added into ``radiance`` (``(n, 3)`` float64,
+    zeros on entry), ``wavefront`` paths at a time (:data:`WAVEFRONT`):
+    camera rays, then every bounce's closest hits, shading, shadow rays and
+    their contributions. ``u`` are the pixel-filter offsets
+    (:func:`~pyoa.render.camera.filter_offsets`), ``lens`` and ``shutter``
+    the lens and time samples (empty when the camera has none), ``rr_key``
+    each path's Russian-roulette key. Adds the seconds of each stage
+    (:data:`STAGES`) to ``spent`` (``clock``: :func:`clock_address`).
+    Returns the number of rays traced."""
+    n = pixel.shape[0]
+    size = max(1, min(wavefront, n))
+    w = new_wavefront(size)
+    ts = np.zeros(2, np.int64)
+    rays = 0
+    for start in range(0, n, size):
+        m = min(size, n - start)
+        stop = start + m
+        t0 = _now(clock, ts)
+        camera_rays(pixel[start:stop], u[start:stop], lens[start:stop] if lens.shape[0] else lens,
+                    shutter[start:stop] if shutter.shape[0] else shutter, cam.width, cam.height, cam.tan_x,
+                    cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, w.o, w.d)
+        for j in range(m):
+            w.lane[j] = start + j
+            w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = 1.0, 1.0, 1.0
+            w.prev_pdf[j] = 0.0
+            w.prev_delta[j] = True  # camera rays count emission fully
+        t1 = _now(clock, ts)
+        spent[0] += t1 - t0
+        live = m
+        for depth in range(1, ps.max_depth + 1):
+            if live == 0:
+                break
+            embree.intersect(tr.scene, tr.hit, tr.packet, w.o[:live], w.d[:live], w.prim, w.t)
+            rays += live
+            t2 = _now(clock, ts)
+            live, shadows = shade(live, depth, sc, ps, x, sample_index, rr_key, w, radiance)
+            t3 = _now(clock, ts)
+            if shadows:
+                embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],
+                                w.sh_dist[:shadows], w.free)
+                rays += shadows
+            t4 = _now(clock, ts)
+            add_visible(shadows, w, radiance)
+            t5 = _now(clock, ts)
+            spent[1] += (t2 - t1) + (t4 - t3)
+            spent[2] += (t3 - t2) + (t5 - t4)
+            t1 = t5
+    return rays
 
 
 def packet_width() -> int:
@@ -238,97 +430,78 @@ def packet_width() -> int:
     return 16 if host_cpu().isa == "AVX-512" else 8
 
 
-class CompiledIntegrator(reference.Integrator):
-    """The path tracer with compiled shading; same constructor and results as
-    :class:`pyoa.render.integrator.Integrator` (up to floating-point rounding).
+class CompiledIntegrator:
+    """The path tracer with compiled shading: the estimator of
+    :class:`pyoa.render.integrator.Integrator` (same constructor; the same
+    image up to floating-point rounding, checked against it within the
+    noise both predict), a batch of paths per compiled call
+    (:func:`render_paths`).
 
     ``packet`` is the Embree packet width (1, 4, 8 or 16; default by CPU,
     :func:`packet_width`). ``timings`` accumulates the seconds spent per
-    stage over every :meth:`radiance` call (``camera``, ``embree``,
-    ``shading``, ``host``).
+    stage over every :meth:`radiance` call: ``camera``, ``embree`` and
+    ``shading`` inside the compiled loop (summed over the threads that ran
+    it), ``host`` the Python around it (the filter's warp, the arrays of a
+    batch).
     """
 
     def __init__(self, scene, layout, width, height, filter="box", packet=None):
-        self.packet = packet_width() if packet is None else packet
-        super().__init__(scene, layout, width, height, filter=filter)
-        self._fn_hit, self._fn_occ = embree.query_addresses(self.packet)
-        self._verts = np.ascontiguousarray(scene.triangles, dtype=np.float64)
-        m = scene.materials
-        self._mats = (np.ascontiguousarray(m.kind, dtype=np.int64), np.ascontiguousarray(m.color),
-                      np.ascontiguousarray(m.alpha))
-        self._emission = np.ascontiguousarray(scene.emission)
-        self._normals = np.ascontiguousarray(scene.normals)
-        self._areas = np.ascontiguousarray(scene.areas)
-        self._material = np.ascontiguousarray(scene.material, dtype=np.int64)
-        em = self.emitters
-        self._em = (np.ascontiguousarray(em.index, dtype=np.int64), np.ascontiguousarray(em.cdf),
-                    np.ascontiguousarray(em.prob))
-        self.timings = {"camera": 0.0, "embree": 0.0, "shading": 0.0, "host": 0.0}
+        from ..camera import FILTERS, PerspectiveCamera
+        from ..emitters import Emitters
 
-    def _build_tracer(self, scene):
-        """The scene built with Embree's own calls, traced from the compiled loops
-        (the reference's ``embreex`` scene is never built here)."""
-        return embree.Scene(scene.triangles)
+        if filter not in FILTERS:
+            raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
+        self.scene, self.layout = scene, layout
+        self.width, self.height, self.filter = width, height, filter
+        self.packet = packet_width() if packet is None else packet
+        # reach and growth before Embree's build, so that their temporaries
+        # do not add to its peak (as the reference)
+        reach, growth = reference.triangle_reach(scene.triangles, scene.normals, scene.areas)
+        self._rtc = embree.Scene(scene.triangles)
+        hit, occ = embree.query_addresses(self.packet)
+        self._tracer = Tracer(self._rtc.handle, hit, occ, self.packet)
+        m, em = scene.materials, Emitters(scene)
+        c = np.ascontiguousarray
+        self._scene = SceneData(
+            verts=c(scene.triangles, dtype=np.float64), normals=c(scene.normals), areas=c(scene.areas),
+            material=c(scene.material, dtype=np.int64), emission=c(scene.emission),
+            kinds=c(m.kind, dtype=np.int64), colors=c(m.color), alphas=c(m.alpha),
+            em=c(em.index, dtype=np.int64), em_cdf=c(em.cdf), em_prob=c(em.prob), reach=c(reach), growth=c(growth))
+        cam = PerspectiveCamera(scene.camera, width, height)
+        self._camera = CameraData(width, height, cam.tan_x, cam.tan_y, c(cam.rot), c(cam.pos), cam.aperture,
+                                  cam.focus_distance, c(cam.motion))
+        L = layout
+        columns = np.full((L.max_depth + 1, 4), -1, np.int64)
+        for depth in range(1, L.max_depth):
+            columns[depth, :2] = L.pair(f"light{depth}")
+            if f"bsdf{depth}.u" in L:
+                columns[depth, 2:] = L.pair(f"bsdf{depth}")
+        self._settings = PathSettings(L.max_depth, bool(L.mis), reference.RR_DEPTH, columns)
+        self._clock = clock_address()
+        #: paths traced together (:data:`WAVEFRONT`; any size gives the same image)
+        self.wavefront = WAVEFRONT
+        self.timings = {"camera": 0.0, "embree": 0.0, "shading": 0.0, "host": 0.0}
 
     def radiance(self, pixel, sample_index, x, seed: int = 0):
         """Radiance (RGB, float64) of the camera paths ``(pixel, sample)`` whose
         sampler rows are ``x`` (as :meth:`pyoa.render.integrator.Integrator.radiance`)."""
         L, n = self.layout, len(pixel)
-        clock = time.perf_counter
-        t0 = clock()
-        stats = Stats(paths=n)
+        t0 = time.perf_counter()
         x = np.ascontiguousarray(x)
         pixel = np.ascontiguousarray(pixel, dtype=np.int64)
-        u = filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), self.filter)
-        cam = self.camera
+        u = np.ascontiguousarray(filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), self.filter))
         lens = x[:, list(L.pair("lens"))].astype(np.float64) if L.lens else np.zeros((0, 2))
         shutter = x[:, L.index("time")].astype(np.float64) if L.time else np.zeros(0)
-        o, d = np.empty((n, 3)), np.empty((n, 3))
-        t1 = clock()
-        camera_rays(pixel, np.ascontiguousarray(u), lens, shutter, self.width, self.height, cam.tan_x, cam.tan_y,
-                    cam.rot, cam.pos, cam.aperture, cam.focus_distance, cam.motion, o, d)
-        t2 = clock()
-        tm = self.timings
-        tm["camera"] += t2 - t1
-        radiance = np.zeros((n, 3))
-        lane = np.arange(n, dtype=np.int64)
-        beta = np.ones((n, 3))
-        prev_pdf = np.zeros(n)
-        prev_delta = np.ones(n, dtype=np.bool_)
         rr_key = reference.hash_pair(reference.U32(seed), pixel.astype(reference.U32), RR_KEY).astype(np.int64)
         sample_index = np.ascontiguousarray(sample_index, dtype=np.int64)
-        prim, hit_t = np.empty(n, np.int64), np.empty(n)
-        sh_o, sh_d, sh_dist = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
-        sh_lane, sh_c, free = np.empty(n, np.int64), np.empty((n, 3)), np.empty(n, np.bool_)
-        kinds, colors, alphas = self._mats
-        live = n
-        tm["host"] += clock() - t2 + (t1 - t0)
-        for depth in range(1, L.max_depth + 1):
-            if live == 0:
-                break
-            t0 = clock()
-            embree.intersect(self._tracer.handle, self._fn_hit, self.packet, o[:live], d[:live], prim, hit_t)
-            stats.rays += live
-            t1 = clock()
-            cols = [-1, -1, -1, -1]
-            if depth < L.max_depth:
-                cols[:2] = L.pair(f"light{depth}")
-                if f"bsdf{depth}.u" in L:
-                    cols[2:] = L.pair(f"bsdf{depth}")
-            live, shadows = shade(live, depth, L.max_depth, L.mis, reference.RR_DEPTH, self.reach, self.growth,
-                                  self._verts, self._normals, self._areas, self._material, self._emission,
-                                  kinds, colors, alphas, *self._em,
-                                  x, *cols, sample_index, rr_key,
-                                  lane, o, d, beta, prev_pdf, prev_delta, prim, hit_t, radiance,
-                                  sh_o, sh_d, sh_dist, sh_lane, sh_c)
-            t2 = clock()
-            if shadows:
-                embree.occluded(self._tracer.handle, self._fn_occ, self.packet, sh_o[:shadows], sh_d[:shadows],
-                                sh_dist[:shadows], free)
-                stats.rays += shadows
-            t3 = clock()
-            add_visible(shadows, free, sh_lane, sh_c, radiance)
-            t4 = clock()
-            tm["embree"] += (t1 - t0) + (t3 - t2)
-            tm["shading"] += (t2 - t1) + (t4 - t3)
-        return radiance, stats
+        radiance = np.zeros((n, 3))
+        spent = np.zeros(len(STAGES))
+        t1 = time.perf_counter()
+        rays = render_paths(self._tracer, self._scene, self._camera, self._settings, pixel, sample_index, x, u,
+                            lens, shutter, rr_key, radiance, spent, self._clock, self.wavefront)
+        t2 = time.perf_counter()
+        tm = self.timings
+        for name, sec in zip(STAGES, spent):
+            tm[name] += float(sec)
+        tm["host"] += (t1 - t0) + max(0.0, (t2 - t1) - spent.sum())
+        return radiance, Stats(paths=n, rays=int(rays))
