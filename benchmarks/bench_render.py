@@ -68,9 +68,10 @@ _MITSUBA = """
 import json, statistics, sys, time
 import numpy as np
 import mitsuba as mi
-w, h, spp, depth, repeats = map(int, sys.argv[1:6])
+w, h, spp, depth, repeats, robust = map(int, sys.argv[1:7])
 mi.set_variant("llvm_ad_rgb")
 d = mi.cornell_box()
+d["embree_use_robust_intersections"] = bool(robust)  # Mitsuba's default: False
 d["sensor"]["sampler"] = {"type": "orthogonal", "sample_count": spp}
 d["sensor"]["film"]["width"], d["sensor"]["film"]["height"] = w, h
 d["integrator"] = {"type": "path", "max_depth": depth}
@@ -87,14 +88,16 @@ print(json.dumps({"status": "ok", "version": mi.__version__, "times_s": times, "
 """
 
 
-def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, repeats: int) -> dict:
+def mitsuba_figure(scene: str, width: int, height: int, spp: int, depth: int, repeats: int, robust: bool) -> dict:
     """Mitsuba 3's ``orthogonal`` sampler on its own ``cornell_box()``, in a
-    subprocess (a Dr.Jit/LLVM failure must not take this benchmark down; ``peers.run_json_script``)."""
+    subprocess (a Dr.Jit/LLVM failure must not take this benchmark down;
+    ``peers.run_json_script``), tracing with Embree's robust mode or without
+    it (Mitsuba's default; its scene property ``embree_use_robust_intersections``)."""
     if not peers.mitsuba_available():
         return {"status": "skipped", "reason": "mitsuba is not installed (pip install mitsuba)"}
     if scene != "cornell":
         return {"status": "skipped", "reason": "only the cornell scene has a Mitsuba twin"}
-    res = peers.run_json_script(_MITSUBA, [width, height, spp, depth, repeats], env=peers.mitsuba_env())
+    res = peers.run_json_script(_MITSUBA, [width, height, spp, depth, repeats, int(robust)], env=peers.mitsuba_env())
     res["libllvm"] = peers.drjit_llvm()
     return res
 
@@ -226,7 +229,7 @@ def embree_floor(scene, args, size=(64, 64)) -> dict:
 
     calls, paths = record_rays(scene, args, size)
     width = ci.packet_width()
-    rtc = embree.Scene(scene.triangles)
+    rtc = embree.Scene(scene.triangles, robust=scene.robust_tracing)
     fn_hit, fn_occ = embree.query_addresses(width)
     rays = sum(len(c[1]) for c in calls)
 
@@ -256,18 +259,32 @@ def _render(scene, args, shading: str, **kw):
                   max_depth=args.max_depth, shading=shading, **kw)
 
 
+def tracing(scene) -> str:
+    """``"robust"`` or ``"fast"``: how the compiled shading traces ``scene``
+    (its ``integrator.robust_tracing``; the NumPy shading is always robust)."""
+    return "robust" if scene.robust_tracing else "fast"
+
+
+def fast_twin(scene):
+    """``scene`` loaded again with ``integrator.robust_tracing`` false."""
+    import dataclasses
+
+    return dataclasses.replace(scene, robust_tracing=False)
+
+
 def time_renders(scene, args, shading: str) -> dict:
     """A 16 x 16 warm-up, then ``--repeats`` timed renders with ``shading``
     (``common.timed``); rates at the median (paths and rays are the same in
     every run: the image is deterministic)."""
+    mode = tracing(scene) if shading == "numba" else "robust"
     _render(scene, args, shading, width=16, height=16)
     t = timed(lambda: _render(scene, args, shading), args.repeats, warmup=False,
-              label=f"{scene.name} {shading}")
+              label=f"{scene.name} {shading} {mode}")
     res = t.pop("result")
     med = t["median_s"]
-    log(f"  {scene.name} {shading}: {res.stats.paths / med / 1e6:.3f} M paths/s, "
+    log(f"  {scene.name} {shading} {mode}: {res.stats.paths / med / 1e6:.3f} M paths/s, "
         f"{res.stats.rays / med / 1e6:.2f} M rays/s")
-    return {"shading": shading, **t, "paths_per_s": res.stats.paths / med, "rays_per_s": res.stats.rays / med,
+    return {"shading": shading, "tracing": mode, **t, "paths_per_s": res.stats.paths / med, "rays_per_s": res.stats.rays / med,
             "rays_per_path": res.stats.rays / res.stats.paths, "dims": res.dims,
             "profile": profile_parts(scene, args, shading)}
 
@@ -336,14 +353,23 @@ def memory_rows(scene_names: list[str], args, shadings: list[str]) -> list[dict]
 
 
 def bench_scene(name: str, args, shadings: list[str]) -> dict:
+    """Every shading on the scene as bundled (robust tracing), the compiled
+    shading also without robust mode, each beside Mitsuba and the Embree
+    floor of the same tracing mode."""
     scene = load(name)
+    assert scene.robust_tracing, "the bundled scenes trace robustly"
     log(f"{name}: {args.size[0]} x {args.size[1]}, {args.sampler} {args.spp} spp, max depth "
         f"{args.max_depth or scene.max_depth}")
-    rows = [time_renders(scene, args, sh) for sh in shadings]
+    variants = [(scene, sh) for sh in shadings]
+    if "numba" in shadings:
+        variants.append((fast_twin(scene), "numba"))
+    rows = [time_renders(sc, args, sh) for sc, sh in variants]
     w, h = args.size
     depth = args.max_depth or scene.max_depth
-    mit = mitsuba_figure(name, w, h, args.spp, depth, args.repeats)
-    floor = embree_floor(scene, args) if "numba" in shadings else None
+    modes = ("robust", "fast") if "numba" in shadings else ("robust",)
+    mit = {mode: mitsuba_figure(name, w, h, args.spp, depth, args.repeats, mode == "robust") for mode in modes}
+    floor = ({mode: embree_floor(sc, args) for mode, sc in (("robust", scene), ("fast", fast_twin(scene)))}
+             if "numba" in shadings else {})
     return {"scene": name, "max_depth": depth, "results": rows, "mitsuba": mit, "embree_floor": floor}
 
 
@@ -395,38 +421,48 @@ def main(argv=None) -> int:
     return 0
 
 
+def _rate(mit: dict):
+    return mit.get("paths_per_s") if mit.get("status") == "ok" else None
+
+
 def scene_markdown(cfg: dict, sc: dict) -> list[str]:
-    mit, floor = sc["mitsuba"], sc["embree_floor"]
+    """A scene's table: each pyoa row beside Mitsuba with the same tracing
+    mode (robust or fast), then the Embree floor of each mode."""
     w, h = cfg["size"]
-    mit_rate = mit.get("paths_per_s") if mit["status"] == "ok" else None
+    mit, floors = sc["mitsuba"], sc["embree_floor"]
     lines = [f"## `{sc['scene']}`", "",
              f"{w} x {h}, max depth {sc['max_depth']}, {cfg['sampler']} {cfg['spp']} spp "
-             f"({sc['results'][0]['dims']} dims), {cfg['repeats']} runs after a warm-up, all CPUs.", "",
-             "| renderer | median s | min s | max s | M paths/s | M rays/s | rays/path | / Mitsuba |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+             f"({sc['results'][0]['dims']} dims), {cfg['repeats']} runs after a warm-up, all CPUs. "
+             "Tracing: `robust` is Embree's robust mode (pyoa's default, watertight at shared edges), `fast` "
+             "without it (Mitsuba's default); each pyoa row is compared with Mitsuba in the same mode.", "",
+             "| renderer | tracing | median s | min s | max s | M paths/s | M rays/s | rays/path | / Mitsuba, same tracing | / Embree floor |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in sc["results"]:
-        ratio = f"{r['paths_per_s'] / mit_rate:.2f}x" if mit_rate else ""
-        lines.append(f"| pyoa, {r['shading']} shading | {r['median_s']:.2f} | {r['min_s']:.2f} | {r['max_s']:.2f} | "
-                     f"{r['paths_per_s'] / 1e6:.3f} | {r['rays_per_s'] / 1e6:.2f} | {r['rays_per_path']:.2f} | {ratio} |")
-    if mit_rate:
-        lines.append(f"| Mitsuba {mit['version']} `orthogonal` (LLVM, {mit.get('libllvm') or 'default libLLVM'}), its "
-                     f"own `cornell_box()` | {mit['median_s']:.2f} | {min(mit['times_s']):.2f} | "
-                     f"{max(mit['times_s']):.2f} | {mit_rate / 1e6:.3f} | | | 1.00x |")
-    else:
-        lines.append(f"| Mitsuba | {mit['status']}: {mit.get('reason')} | | | | | | |")
-    if floor:
-        numba = next((r for r in sc["results"] if r["shading"] == "numba"), None)
-        share = f"; the numba renderer reaches {numba['paths_per_s'] / floor['paths_per_s']:.0%} of it" if numba else ""
-        ratio = f" = {floor['paths_per_s'] / mit_rate:.2f}x Mitsuba" if mit_rate else ""
-        lines += ["", f"Embree floor (the rays of a {floor['size'][0]} x {floor['size'][1]} render of the same "
-                      f"scene replayed through the shipped tracing path: {floor['packet']}-wide packets from numba, "
-                      f"{floor['threads']} threads): {floor['rays_per_s'] / 1e6:.2f} M rays/s = "
-                      f"{floor['paths_per_s'] / 1e6:.3f} M paths/s at {floor['rays_per_path']:.2f} rays/path"
-                      f"{ratio}{share}."]
+        rate = _rate(mit.get(r["tracing"], {}))
+        floor = floors.get(r["tracing"]) if r["shading"] == "numba" else None
+        ratio = f"{r['paths_per_s'] / rate:.2f}x" if rate else ""
+        share = f"{r['paths_per_s'] / floor['paths_per_s']:.0%}" if floor else ""
+        lines.append(f"| pyoa, {r['shading']} shading | {r['tracing']} | {r['median_s']:.2f} | {r['min_s']:.2f} | "
+                     f"{r['max_s']:.2f} | {r['paths_per_s'] / 1e6:.3f} | {r['rays_per_s'] / 1e6:.2f} | "
+                     f"{r['rays_per_path']:.2f} | {ratio} | {share} |")
+    for mode, m in mit.items():
+        if _rate(m):
+            lines.append(f"| Mitsuba {m['version']} `orthogonal` (LLVM, {m.get('libllvm') or 'default libLLVM'}), "
+                         f"its own `cornell_box()` | {mode} | {m['median_s']:.2f} | {min(m['times_s']):.2f} | "
+                         f"{max(m['times_s']):.2f} | {m['paths_per_s'] / 1e6:.3f} | | | 1.00x | |")
+        else:
+            lines.append(f"| Mitsuba | {mode} | {m['status']}: {m.get('reason')} | | | | | | | |")
+    for mode, floor in floors.items():
+        rate = _rate(mit.get(mode, {}))
+        ratio = f" = {floor['paths_per_s'] / rate:.2f}x Mitsuba ({mode})" if rate else ""
+        lines += ["", f"Embree floor, {mode} tracing (the rays of a {floor['size'][0]} x {floor['size'][1]} render "
+                      f"of the same scene replayed through the shipped tracing path: {floor['packet']}-wide packets "
+                      f"from numba, {floor['threads']} threads): {floor['rays_per_s'] / 1e6:.2f} M rays/s = "
+                      f"{floor['paths_per_s'] / 1e6:.3f} M paths/s at {floor['rays_per_path']:.2f} rays/path{ratio}."]
     profs = [r for r in sc["results"]]
     parts = list(dict.fromkeys(k for r in profs for k in r["profile"]["parts_s"]))
     lines += ["", "Where the time goes (a separate render on 1 thread; seconds and share of it):", "",
-              "| part | " + " | ".join(f"{r['shading']}" for r in profs) + " |",
+              "| part | " + " | ".join(f"{r['shading']}, {r['tracing']}" for r in profs) + " |",
               "|---|" + "---:|" * len(profs)]
     for k in parts:
         cells = [(f"{r['profile']['parts_s'][k]:.2f} s ({100 * r['profile']['shares'][k]:.0f} %)"

@@ -134,11 +134,12 @@ class Scene:
     robust : bool
         Embree's robust mode (``RTC_SCENE_FLAG_ROBUST``: a conservative
         traversal and watertight triangle test), as ``embreex`` builds its
-        scenes: the default, and what the renderer traces with. Without it
-        tracing is 1.4-1.6x faster, but rays through a shared edge can pass
-        between its two triangles: about 2 % of the rays aimed exactly at
-        the seams of the bundled scenes leak, against none in robust mode
-        (``tests/render/test_embree.py``; docs/performance.md, "Tracing").
+        scenes: the default (a scene's ``integrator.robust_tracing``).
+        Without it tracing is 1.4-1.6x faster (as Mitsuba 3 traces by
+        default), but rays through a shared edge can pass between its two
+        triangles: about 2 % of the rays aimed exactly at the seams of the
+        bundled scenes leak, against none in robust mode
+        (``tests/render/test_embree.py``; docs/rendering.md, "Tracing").
 
     The BVH is built on one thread (the device's ``threads=1``), so the
     same triangles give the same BVH, and every ray the same hit, in every

@@ -147,3 +147,38 @@ def test_without_numba_the_reference_renders_with_one_warning(tmp_path):
     assert len(warns) == 1 and "ShadingFallbackWarning" in warns[0] and "numba hidden" in warns[0], res.stdout
     assert "PYOA_SHADING=numpy" in warns[0]
     assert "RAISED compiled shading is not usable here" in res.stdout
+
+
+def _with_tracing(tmp_path, name, value):
+    """A copy of a bundled scene with ``integrator.robust_tracing`` set."""
+    import json
+
+    from pyoa.render.scene import bundled
+
+    data = json.loads(open(bundled()[name]).read())
+    data.setdefault("integrator", {})["robust_tracing"] = value
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+@pytest.mark.parametrize("name", ["cornell", "deep"])
+def test_fast_tracing_changes_only_rays_at_seams(tmp_path, name):
+    """``integrator.robust_tracing: false`` traces without Embree's robust
+    mode: the same hits but for the rare ray through a shared edge, at
+    distances that differ in their last float32 bits, so the same image to
+    rounding (a relative 1e-5 here) but for a few pixels at most."""
+    robust = load(name)
+    fast = load(_with_tracing(tmp_path, name, False))
+    assert robust.robust_tracing and not fast.robust_tracing
+    kw = dict(sampler="bose", spp=49, seed=7, width=32, height=32, shading="numba")
+    a, b = render(robust, **kw).image, render(fast, **kw).image
+    assert not np.array_equal(a, b)  # two tracers really ran
+    differ = np.any(np.abs(a - b) > 1e-5 * np.maximum(np.abs(a), 1e-3), axis=2)
+    assert differ.sum() <= 2, f"{differ.sum()} of {differ.size} pixels differ beyond rounding"
+    assert render(load(_with_tracing(tmp_path, name, True)), **kw).image.tobytes() == a.tobytes()
+
+
+def test_robust_tracing_must_be_a_boolean(tmp_path):
+    with pytest.raises(ValueError, match=r"integrator\.robust_tracing"):
+        load(_with_tracing(tmp_path, "cornell", "yes"))

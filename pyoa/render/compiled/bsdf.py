@@ -94,8 +94,8 @@ def sample(kind, cr, cg, cb, alpha, ox, oy, oz, u0, u1):
     if kind == DIFFUSE:
         x, y = concentric_disk(u0, u1)
         z = math.sqrt(max(0.0, 1.0 - x * x - y * y))
-        n = math.sqrt(x * x + y * y + z * z)
-        x, y, z = x / n, y / n, z / n
+        inv = 1.0 / math.sqrt(x * x + y * y + z * z)
+        x, y, z = x * inv, y * inv, z * inv
         if z > 0.0:
             return x, y, z, cr, cg, cb, z / math.pi, False
         return x, y, z, 0.0, 0.0, 0.0, 0.0, False

@@ -17,7 +17,16 @@ def sample_emitter(em, em_cdf, em_prob, verts, normals, areas, u0, u1):
     """A point on an emitter chosen by power: ``(triangle, point, normal, pdf
     per unit area)``, as :meth:`pyoa.render.emitters.Emitters.sample` (``em``,
     ``em_cdf``, ``em_prob`` are its ``index``, ``cdf`` and ``prob``)."""
-    k = min(np.searchsorted(em_cdf, u0, side="right"), em.shape[0] - 1)
+    # the first k with em_cdf[k] > u0 (NumPy's searchsorted, side="right",
+    # which costs a generic call per lane), clamped to the last emitter
+    lo, hi = 0, em_cdf.shape[0]
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if em_cdf[mid] <= u0:
+            lo = mid + 1
+        else:
+            hi = mid
+    k = min(lo, em.shape[0] - 1)
     lo = em_cdf[k - 1] if k > 0 else 0.0
     v = min(max((u0 - lo) / (em_cdf[k] - lo), 0.0), _BELOW_ONE)
     tri = em[k]

@@ -205,7 +205,9 @@ def new_wavefront(size):
 @njit(**_JIT)
 def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance):
     """One bounce of the ``n`` live lanes of the wavefront ``w``, whose
-    closest hits are ``w.prim``/``w.t``.
+    closest hits are ``w.prim``/``w.t``. The reference's formulas, with
+    products by a reciprocal where it divides several numbers by one (the
+    same values to rounding: divisions were a third of a bounce).
 
     Adds the emission each ray sees (MIS-weighted) to ``radiance``; writes
     the next-event shadow rays and their contributions (``w.sh_*``); samples
@@ -269,8 +271,8 @@ def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance):
                 np.float64(x[li, light_u]), np.float64(x[li, light_v]))
             vx, vy, vz = qx - px, qy - py, qz - pz
             dist = math.sqrt(vx * vx + vy * vy + vz * vz)
-            dn = max(dist, 1e-12)
-            wx, wy, wz = vx / dn, vy / dn, vz / dn
+            inv = 1.0 / max(dist, 1e-12)  # one division, three products (the reference divides thrice)
+            wx, wy, wz = vx * inv, vy * inv, vz * inv
             cos_q = -(mx * wx + my * wy + mz * wz)
             fr, fg, fb, pdf_b = evaluate(kind, cr, cg, cb, alpha, wox, woy, woz,
                                          wx * tx + wy * ty + wz * tz, wx * bx + wy * by + wz * bz,
@@ -285,11 +287,11 @@ def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance):
                 eq = offset_distance(qx, qy, qz, mx, my, mz, dist * growth[etri] + reach[etri])
                 gx, gy, gz = qx + eq * mx - ax, qy + eq * my - ay, qz + eq * mz - az
                 seg = math.sqrt(gx * gx + gy * gy + gz * gz)
-                sn = max(seg, 1e-12)
-                wl = power_heuristic(pdf_l, pdf_b) if mis else 1.0
-                f = wl / pdf_l
+                inv = 1.0 / max(seg, 1e-12)
+                # power_heuristic(pdf_l, pdf_b) / pdf_l in one division
+                f = pdf_l / max(pdf_l * pdf_l + pdf_b * pdf_b, 1e-300) if mis else 1.0 / pdf_l
                 sh_o[shadows, 0], sh_o[shadows, 1], sh_o[shadows, 2] = ax, ay, az
-                sh_d[shadows, 0], sh_d[shadows, 1], sh_d[shadows, 2] = gx / sn, gy / sn, gz / sn
+                sh_d[shadows, 0], sh_d[shadows, 1], sh_d[shadows, 2] = gx * inv, gy * inv, gz * inv
                 sh_dist[shadows] = seg
                 sh_lane[shadows] = li
                 sh_c[shadows, 0] = br * fr * emission[etri, 0] * f
@@ -423,11 +425,13 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, lens, shutter, rr_k
 
 
 def packet_width() -> int:
-    """Embree packet width for this CPU: 16 lanes with AVX-512, else 8
-    (the native width of AVX2); see docs/performance.md for the measurements."""
-    from ...hostcpu import host_cpu
-
-    return 16 if host_cpu().isa == "AVX-512" else 8
+    """Embree packet width: 8 lanes on every CPU. On the Intel Xeon of family
+    6 model 207 (AVX-512) whole renders ran 5-15 % faster with 8 than with
+    16 (robust tracing; 1, 4, 8 and 16 measured in one process), on the AMD
+    EPYC Zen 4 the two were within 2 % (docs/performance.md, "Rendering");
+    every width gives the same hits (tested), so the choice changes speed
+    only."""
+    return 8
 
 
 class CompiledIntegrator:
@@ -457,7 +461,7 @@ class CompiledIntegrator:
         # reach and growth before Embree's build, so that their temporaries
         # do not add to its peak (as the reference)
         reach, growth = reference.triangle_reach(scene.triangles, scene.normals, scene.areas)
-        self._rtc = embree.Scene(scene.triangles)
+        self._rtc = embree.Scene(scene.triangles, robust=getattr(scene, "robust_tracing", True))
         hit, occ = embree.query_addresses(self.packet)
         self._tracer = Tracer(self._rtc.handle, hit, occ, self.packet)
         m, em = scene.materials, Emitters(scene)
