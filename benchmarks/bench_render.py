@@ -4,30 +4,36 @@
 What is measured
 ----------------
 For each scene of ``--scenes`` (default: ``cornell``, ``dof7d``, ``bounce9d``
-and ``deep``, each at its own max depth unless ``--max-depth`` is given) and
-each ``--shading`` (numba: compiled shading calling Embree, the default;
-numpy: the reference), ``pyoa.render.render.render(scene, sampler=...,
-spp=..., width=W, height=H)`` (the function behind ``pyoa render``) runs once
-as a warm-up on a 16 x 16 image (kernel build, numba's cache, Embree and
-import costs), then ``--repeats`` timed full renders (``common.timed``). The
-time covers sample generation, ray tracing and shading, not scene loading or
-image writing. Reported: median, minimum and maximum seconds; camera paths
-per second and rays per second (camera, continuation and shadow rays) at the
-median; and a separate single-threaded profile of where the time goes
-(sampling, Embree, each compiled stage, host bookkeeping).
-
-Beside them, in the same run:
+and ``deep``, each at its own max depth unless ``--max-depth`` is given),
+``pyoa.render.render.render(scene, sampler=..., spp=..., width=W,
+height=H)`` (the function behind ``pyoa render``) with each ``--shading``
+(numba: compiled shading calling Embree, the default; numpy: the
+reference) on the scene as bundled (robust tracing), and with the numba
+shading also on its twin with ``integrator.robust_tracing`` false. Each
+runs once as a warm-up on a 16 x 16 image (kernel build, numba's cache,
+Embree and import costs); then ``--repeats`` **interleaved rounds** time
+every row once each, beside, in the same round:
 
 - **Mitsuba 3** (``cornell`` only: its own ``cornell_box()`` is the scene's
   twin), ``orthogonal`` sampler, LLVM backend, path integrator, if
-  ``mitsuba`` is importable; otherwise the report says it was skipped;
-- the **Embree floor**: a 64 x 64 render's own rays replayed through the
-  shipped tracing path (Embree packets called from numba) on two threads,
-  i.e. what the renderer would reach if shading were free;
-- **peak memory** (``--memory``, on by default): a fresh process renders the
-  scene at the full size with each shading and reports its resident-set peak
-  above the warmed-up baseline, beside the bound the renderer states
-  (``pyoa.render.render.working_set_bytes``).
+  ``mitsuba`` is importable (otherwise the report says it was skipped), in
+  both tracing modes (its ``embree_use_robust_intersections``; its default
+  is false), one subprocess per round and mode;
+- the **Embree floor** of each tracing mode: a 64 x 64 render's own rays
+  replayed through the shipped tracing path (Embree packets called from
+  numba) on two threads, i.e. what the renderer would reach if shading
+  were free.
+
+The time covers sample generation, ray tracing and shading, not scene
+loading or image writing. Reported: median, minimum and maximum seconds;
+camera paths per second and rays per second (camera, continuation and
+shadow rays) at the median; the ratios to Mitsuba and to the floor as
+medians of per-round ratios (the machine drifts 15-40 % over minutes,
+which rounds spread over every row alike); a separate single-threaded
+profile of where the time goes (sampling, camera rays, Embree, shading,
+host bookkeeping); and **peak memory** (``--memory``, on by default): a
+fresh process renders the scene at the full size with each shading and
+reports its resident-set peak above the warmed-up baseline.
 
 Output: ``benchmarks/results/render.json`` and ``render.md`` (``--out``),
 written atomically.
@@ -57,7 +63,7 @@ sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared w
 import numpy as np  # noqa: E402
 
 import peers  # noqa: E402
-from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, timed, write_text  # noqa: E402
+from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
 from pyoa.render.render import BATCH_PATHS, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
@@ -215,42 +221,52 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     return calls, len(pixel)
 
 
-def embree_floor(scene, args, size=(64, 64)) -> dict:
+class EmbreeFloor:
     """The tracing path pyoa ships (Embree packets called from numba, the
     scene built as the renderer builds it) alone: the rays of a ``size``
-    render of the same scene, sampler, spp and depth (:func:`record_rays`)
-    replayed on two threads (each half of the wavefronts), median of 3.
-    ``paths_per_s`` is the rate at the render's own rays per path: what the
-    renderer would reach if shading, sampling and bookkeeping were free."""
-    from concurrent.futures import ThreadPoolExecutor
+    render of the same scene, sampler, spp and depth (:func:`record_rays`),
+    replayed on two threads (each half of the wavefronts) by :meth:`run`.
+    Its ``paths_per_s`` is the rate at the render's own rays per path: what
+    the renderer would reach if shading, sampling and bookkeeping were free."""
 
-    from pyoa.render import embree
-    from pyoa.render.compiled import integrator as ci
+    def __init__(self, scene, args, size=(96, 96)):
+        from pyoa.render import embree
+        from pyoa.render.compiled import integrator as ci
 
-    calls, paths = record_rays(scene, args, size)
-    width = ci.packet_width()
-    rtc = embree.Scene(scene.triangles, robust=scene.robust_tracing)
-    fn_hit, fn_occ = embree.query_addresses(width)
-    rays = sum(len(c[1]) for c in calls)
+        self.calls, paths = record_rays(scene, args, size)
+        self.size, self.packet, self.mode = list(size), ci.packet_width(), tracing(scene)
+        self.rtc = embree.Scene(scene.triangles, robust=scene.robust_tracing)
+        self.fns = embree.query_addresses(self.packet)
+        self.rays = sum(len(c[1]) for c in self.calls)
+        self.rays_per_path = self.rays / paths
+        self.times = []
+        self._replay(self.calls[:4])  # warm
 
-    def replay(part):
+    def _replay(self, part):
+        from pyoa.render import embree
+
         for kind, o, d, dist in part:
             if kind == "hit":
-                embree.intersect(rtc.handle, fn_hit, width, o, d, np.empty(len(o), np.int64), np.empty(len(o)))
+                embree.intersect(self.rtc.handle, self.fns[0], self.packet, o, d, np.empty(len(o), np.int64),
+                                 np.empty(len(o)))
             else:
-                embree.occluded(rtc.handle, fn_occ, width, o, d, dist, np.empty(len(o), np.bool_))
+                embree.occluded(self.rtc.handle, self.fns[1], self.packet, o, d, dist, np.empty(len(o), np.bool_))
 
-    replay(calls[:4])  # warm
-    times = []
-    with ThreadPoolExecutor(2) as pool:
-        for _ in range(3):
+    def run(self) -> float:
+        """One timed replay on two threads; returns its M paths/s equivalent's rate (paths/s)."""
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(2) as pool:
             t0 = time.perf_counter()
-            list(pool.map(replay, [calls[0::2], calls[1::2]]))
-            times.append(time.perf_counter() - t0)
-    med = statistics.median(times)
-    rays_per_path = rays / paths
-    return {"size": list(size), "rays": rays, "packet": width, "threads": 2, "times_s": times,
-            "rays_per_s": rays / med, "rays_per_path": rays_per_path, "paths_per_s": rays / med / rays_per_path}
+            list(pool.map(self._replay, [self.calls[0::2], self.calls[1::2]]))
+            self.times.append(time.perf_counter() - t0)
+        return self.rays / self.times[-1] / self.rays_per_path
+
+    def summary(self) -> dict:
+        med = statistics.median(self.times)
+        return {"size": self.size, "rays": self.rays, "packet": self.packet, "threads": 2, "times_s": self.times,
+                "rays_per_s": self.rays / med, "rays_per_path": self.rays_per_path,
+                "paths_per_s": self.rays / med / self.rays_per_path}
 
 
 def _render(scene, args, shading: str, **kw):
@@ -272,21 +288,16 @@ def fast_twin(scene):
     return dataclasses.replace(scene, robust_tracing=False)
 
 
-def time_renders(scene, args, shading: str) -> dict:
-    """A 16 x 16 warm-up, then ``--repeats`` timed renders with ``shading``
-    (``common.timed``); rates at the median (paths and rays are the same in
-    every run: the image is deterministic)."""
+def _row(scene, shading: str, times: list, res) -> dict:
+    """A pyoa row from its timed renders (paths and rays are the same in
+    every run: the image is deterministic); rates at the median."""
+    med = statistics.median(times)
     mode = tracing(scene) if shading == "numba" else "robust"
-    _render(scene, args, shading, width=16, height=16)
-    t = timed(lambda: _render(scene, args, shading), args.repeats, warmup=False,
-              label=f"{scene.name} {shading} {mode}")
-    res = t.pop("result")
-    med = t["median_s"]
     log(f"  {scene.name} {shading} {mode}: {res.stats.paths / med / 1e6:.3f} M paths/s, "
         f"{res.stats.rays / med / 1e6:.2f} M rays/s")
-    return {"shading": shading, "tracing": mode, **t, "paths_per_s": res.stats.paths / med, "rays_per_s": res.stats.rays / med,
-            "rays_per_path": res.stats.rays / res.stats.paths, "dims": res.dims,
-            "profile": profile_parts(scene, args, shading)}
+    return {"shading": shading, "tracing": mode, "times_s": times, "median_s": med, "min_s": min(times),
+            "max_s": max(times), "paths_per_s": res.stats.paths / med, "rays_per_s": res.stats.rays / med,
+            "rays_per_path": res.stats.rays / res.stats.paths, "dims": res.dims}
 
 
 # ---------------------------------------------------------------------------
@@ -354,23 +365,67 @@ def memory_rows(scene_names: list[str], args, shadings: list[str]) -> list[dict]
 
 def bench_scene(name: str, args, shadings: list[str]) -> dict:
     """Every shading on the scene as bundled (robust tracing), the compiled
-    shading also without robust mode, each beside Mitsuba and the Embree
-    floor of the same tracing mode."""
+    shading also without robust mode, Mitsuba in both tracing modes and the
+    Embree floor of each mode, **interleaved**: ``--repeats`` rounds, each
+    timing every one of them once, so that the machine's drift (15-40 %
+    over minutes) falls on all alike; the ratios are medians of the
+    per-round ratios (each pyoa render against Mitsuba and the floor of its
+    own round and tracing mode). Then a single-threaded profile per row."""
     scene = load(name)
     assert scene.robust_tracing, "the bundled scenes trace robustly"
-    log(f"{name}: {args.size[0]} x {args.size[1]}, {args.sampler} {args.spp} spp, max depth "
-        f"{args.max_depth or scene.max_depth}")
+    w, h = args.size
+    depth = args.max_depth or scene.max_depth
+    log(f"{name}: {w} x {h}, {args.sampler} {args.spp} spp, max depth {depth}")
     variants = [(scene, sh) for sh in shadings]
     if "numba" in shadings:
         variants.append((fast_twin(scene), "numba"))
-    rows = [time_renders(sc, args, sh) for sc, sh in variants]
-    w, h = args.size
-    depth = args.max_depth or scene.max_depth
     modes = ("robust", "fast") if "numba" in shadings else ("robust",)
-    mit = {mode: mitsuba_figure(name, w, h, args.spp, depth, args.repeats, mode == "robust") for mode in modes}
-    floor = ({mode: embree_floor(sc, args) for mode, sc in (("robust", scene), ("fast", fast_twin(scene)))}
-             if "numba" in shadings else {})
-    return {"scene": name, "max_depth": depth, "results": rows, "mitsuba": mit, "embree_floor": floor}
+    floors = {m: EmbreeFloor(sc, args) for m, sc in (("robust", scene), ("fast", fast_twin(scene))) if m in modes
+              and "numba" in shadings}
+    for sc, sh in variants:  # warm-up: kernel builds, numba's cache, Embree and imports
+        _render(sc, args, sh, width=16, height=16)
+    times, last = [[] for _ in variants], [None] * len(variants)
+    mit = {m: {"status": "skipped", "reason": "only the cornell scene has a Mitsuba twin"} for m in modes}
+    mit_rounds = {m: [] for m in modes}
+    floor_rounds = {m: [] for m in floors}
+    for r in range(args.repeats):
+        for i, (sc, sh) in enumerate(variants):
+            t0 = time.perf_counter()
+            last[i] = _render(sc, args, sh)
+            times[i].append(time.perf_counter() - t0)
+            log(f"  round {r + 1}/{args.repeats}: {name} {sh} {tracing(sc) if sh == 'numba' else 'robust'}: "
+                f"{times[i][-1]:.3f} s")
+        for m in modes:
+            res = mitsuba_figure(name, w, h, args.spp, depth, 1, m == "robust")
+            if res.get("status") == "ok":
+                mit_rounds[m].append(res["paths_per_s"])
+                prev = mit[m] if mit[m].get("status") == "ok" else {**res, "times_s": []}
+                prev["times_s"] = prev["times_s"] + res["times_s"]
+                mit[m] = prev
+                log(f"  round {r + 1}/{args.repeats}: Mitsuba {m}: {res['times_s'][0]:.3f} s")
+            else:
+                mit[m] = res
+        for m, fl in floors.items():
+            floor_rounds[m].append(fl.run())
+    for m, res in mit.items():
+        if res.get("status") == "ok":
+            med = statistics.median(res["times_s"])
+            res.update(median_s=med, paths_per_s=w * h * args.spp / med)
+    rows = []
+    for i, (sc, sh) in enumerate(variants):
+        row = _row(sc, sh, times[i], last[i])
+        paths = last[i].stats.paths
+        rates = [paths / t for t in times[i]]
+        if sh == "numba":
+            m = row["tracing"]
+            if len(mit_rounds[m]) == len(rates):
+                row["vs_mitsuba"] = statistics.median(a / b for a, b in zip(rates, mit_rounds[m]))
+            if m in floor_rounds:
+                row["vs_floor"] = statistics.median(a / b for a, b in zip(rates, floor_rounds[m]))
+        row["profile"] = profile_parts(sc, args, sh)
+        rows.append(row)
+    return {"scene": name, "max_depth": depth, "results": rows, "mitsuba": mit,
+            "embree_floor": {m: fl.summary() for m, fl in floors.items()}}
 
 
 def _csv(text: str, valid: tuple[str, ...], what: str) -> list[str]:
@@ -432,16 +487,16 @@ def scene_markdown(cfg: dict, sc: dict) -> list[str]:
     mit, floors = sc["mitsuba"], sc["embree_floor"]
     lines = [f"## `{sc['scene']}`", "",
              f"{w} x {h}, max depth {sc['max_depth']}, {cfg['sampler']} {cfg['spp']} spp "
-             f"({sc['results'][0]['dims']} dims), {cfg['repeats']} runs after a warm-up, all CPUs. "
-             "Tracing: `robust` is Embree's robust mode (pyoa's default, watertight at shared edges), `fast` "
-             "without it (Mitsuba's default); each pyoa row is compared with Mitsuba in the same mode.", "",
+             f"({sc['results'][0]['dims']} dims), {cfg['repeats']} interleaved rounds after a warm-up (each round "
+             "times every row and the floors once), all CPUs. Tracing: `robust` is Embree's robust mode (pyoa's "
+             "default, watertight at shared edges), `fast` without it (Mitsuba's default). The ratios are medians "
+             "of per-round ratios, each pyoa render against Mitsuba and the Embree floor of the same round and "
+             "tracing mode.", "",
              "| renderer | tracing | median s | min s | max s | M paths/s | M rays/s | rays/path | / Mitsuba, same tracing | / Embree floor |",
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in sc["results"]:
-        rate = _rate(mit.get(r["tracing"], {}))
-        floor = floors.get(r["tracing"]) if r["shading"] == "numba" else None
-        ratio = f"{r['paths_per_s'] / rate:.2f}x" if rate else ""
-        share = f"{r['paths_per_s'] / floor['paths_per_s']:.0%}" if floor else ""
+        ratio = f"{r['vs_mitsuba']:.2f}x" if "vs_mitsuba" in r else ""
+        share = f"{r['vs_floor']:.0%}" if "vs_floor" in r else ""
         lines.append(f"| pyoa, {r['shading']} shading | {r['tracing']} | {r['median_s']:.2f} | {r['min_s']:.2f} | "
                      f"{r['max_s']:.2f} | {r['paths_per_s'] / 1e6:.3f} | {r['rays_per_s'] / 1e6:.2f} | "
                      f"{r['rays_per_path']:.2f} | {ratio} | {share} |")
@@ -457,8 +512,9 @@ def scene_markdown(cfg: dict, sc: dict) -> list[str]:
         ratio = f" = {floor['paths_per_s'] / rate:.2f}x Mitsuba ({mode})" if rate else ""
         lines += ["", f"Embree floor, {mode} tracing (the rays of a {floor['size'][0]} x {floor['size'][1]} render "
                       f"of the same scene replayed through the shipped tracing path: {floor['packet']}-wide packets "
-                      f"from numba, {floor['threads']} threads): {floor['rays_per_s'] / 1e6:.2f} M rays/s = "
-                      f"{floor['paths_per_s'] / 1e6:.3f} M paths/s at {floor['rays_per_path']:.2f} rays/path{ratio}."]
+                      f"from numba, {floor['threads']} threads; median of the rounds): "
+                      f"{floor['rays_per_s'] / 1e6:.2f} M rays/s = {floor['paths_per_s'] / 1e6:.3f} M paths/s at "
+                      f"{floor['rays_per_path']:.2f} rays/path{ratio}."]
     profs = [r for r in sc["results"]]
     parts = list(dict.fromkeys(k for r in profs for k in r["profile"]["parts_s"]))
     lines += ["", "Where the time goes (a separate render on 1 thread; seconds and share of it):", "",

@@ -85,15 +85,18 @@ def test_compiled_and_numpy_agree_within_their_noise(name):
     _noise_check(load(name), sampler="bose", spp=25, width=24, height=24)
 
 
-def test_packet_widths_batches_and_threads_give_the_same_bits(monkeypatch):
+def test_packet_widths_batches_wavefronts_and_threads_give_the_same_bits(monkeypatch):
     sc = load("deep")  # GGX, mirror, long paths, Russian roulette
     kw = dict(sampler="bose", spp=9, seed=4, width=16, height=16, shading="numba")
     ref = render(sc, **kw, threads=1).image.tobytes()
-    for width in (1, 4, 8, 16):
+    for width, wavefront in ((1, 512), (4, 7), (8, 1), (16, 4096)):
         monkeypatch.setattr(ci, "packet_width", lambda w=width: w)
+        monkeypatch.setattr(ci, "WAVEFRONT", wavefront)
         for batch_paths, threads in ((9 * 7, 2), (1 << 16, 2), (1, 1)):
-            img = render(sc, **kw, batch_paths=batch_paths, threads=threads).image
-            assert img.tobytes() == ref, f"packet {width}, batch_paths={batch_paths}, threads={threads}"
+            res = render(sc, **kw, batch_paths=batch_paths, threads=threads)
+            assert res.integrator[0].wavefront == wavefront and res.integrator[0].packet == width
+            assert res.image.tobytes() == ref, (f"packet {width}, wavefront {wavefront}, batch_paths={batch_paths}, "
+                                                f"threads={threads}")
 
 
 def test_timings_cover_the_stages():

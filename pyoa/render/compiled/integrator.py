@@ -162,6 +162,8 @@ class PathSettings(NamedTuple):
     mis: bool
     rr_depth: int
     columns: np.ndarray  # (max_depth + 1, 4) int64: light u, v, bsdf u, v of each depth; -1 where none
+    camera_columns: np.ndarray  # (5,) int64: pixel u, v, lens u, v, time; -1 where none
+    seed: int  # the sampler's user seed, the Russian-roulette keys' first word
 
 
 class Tracer(NamedTuple):
@@ -371,16 +373,17 @@ def _now(clock, ts):
 
 
 @njit(**_JIT)
-def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, lens, shutter, rr_key, radiance, spent, clock,
-                 wavefront):
+def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, wavefront):
     """Radiance of the camera paths ``(pixel[i], sample_index[i])`` whose
     sampler rows are ``x[i]``, added into ``radiance`` (``(n, 3)`` float64,
     zeros on entry), ``wavefront`` paths at a time (:data:`WAVEFRONT`):
     camera rays, then every bounce's closest hits, shading, shadow rays and
-    their contributions. ``u`` are the pixel-filter offsets
-    (:func:`~pyoa.render.camera.filter_offsets`), ``lens`` and ``shutter``
-    the lens and time samples (empty when the camera has none), ``rr_key``
-    each path's Russian-roulette key. Adds the seconds of each stage
+    their contributions. The camera's samples are read from ``x``
+    (``ps.camera_columns``); ``u`` are the pixel-filter offsets of a
+    Gaussian filter (:func:`~pyoa.render.camera.filter_offsets`, which
+    needs SciPy), empty for the box filter, whose offsets are the samples
+    themselves. Each path's Russian-roulette key is ``hash_pair(ps.seed,
+    pixel, RR_KEY)``. Adds the seconds of each stage
     (:data:`STAGES`) to ``spent`` (``clock``: :func:`clock_address`).
     Returns the number of rays traced."""
     n = pixel.shape[0]
@@ -388,12 +391,30 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, lens, shutter, rr_k
     w = new_wavefront(size)
     ts = np.zeros(2, np.int64)
     rays = 0
+    t0 = _now(clock, ts)
+    rr_key = np.empty(n, np.int64)
+    for i in range(n):
+        rr_key[i] = hash_pair(np.int64(ps.seed), pixel[i], RR_KEY)
+    cc = ps.camera_columns
+    uw = np.empty((size, 2))
+    lens = np.empty((size if cc[2] >= 0 else 0, 2))
+    shutter = np.empty(size if cc[4] >= 0 else 0)
+    spent[0] += _now(clock, ts) - t0
     for start in range(0, n, size):
         m = min(size, n - start)
         stop = start + m
         t0 = _now(clock, ts)
-        camera_rays(pixel[start:stop], u[start:stop], lens[start:stop] if lens.shape[0] else lens,
-                    shutter[start:stop] if shutter.shape[0] else shutter, cam.width, cam.height, cam.tan_x,
+        for j in range(m):
+            i = start + j
+            if u.shape[0]:
+                uw[j, 0], uw[j, 1] = u[i, 0], u[i, 1]
+            else:
+                uw[j, 0], uw[j, 1] = np.float64(x[i, cc[0]]), np.float64(x[i, cc[1]])
+            if lens.shape[0]:
+                lens[j, 0], lens[j, 1] = np.float64(x[i, cc[2]]), np.float64(x[i, cc[3]])
+            if shutter.shape[0]:
+                shutter[j] = np.float64(x[i, cc[4]])
+        camera_rays(pixel[start:stop], uw[:m], lens[:m], shutter[:m], cam.width, cam.height, cam.tan_x,
                     cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, w.o, w.d)
         for j in range(m):
             w.lane[j] = start + j
@@ -480,7 +501,9 @@ class CompiledIntegrator:
             columns[depth, :2] = L.pair(f"light{depth}")
             if f"bsdf{depth}.u" in L:
                 columns[depth, 2:] = L.pair(f"bsdf{depth}")
-        self._settings = PathSettings(L.max_depth, bool(L.mis), reference.RR_DEPTH, columns)
+        camera = np.array([*L.pair("pixel"), *(L.pair("lens") if L.lens else (-1, -1)),
+                           L.index("time") if L.time else -1], np.int64)
+        self._settings = PathSettings(L.max_depth, bool(L.mis), reference.RR_DEPTH, columns, camera, 0)
         self._clock = clock_address()
         #: paths traced together (:data:`WAVEFRONT`; any size gives the same image)
         self.wavefront = WAVEFRONT
@@ -493,16 +516,15 @@ class CompiledIntegrator:
         t0 = time.perf_counter()
         x = np.ascontiguousarray(x)
         pixel = np.ascontiguousarray(pixel, dtype=np.int64)
-        u = np.ascontiguousarray(filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), self.filter))
-        lens = x[:, list(L.pair("lens"))].astype(np.float64) if L.lens else np.zeros((0, 2))
-        shutter = x[:, L.index("time")].astype(np.float64) if L.time else np.zeros(0)
-        rr_key = reference.hash_pair(reference.U32(seed), pixel.astype(reference.U32), RR_KEY).astype(np.int64)
         sample_index = np.ascontiguousarray(sample_index, dtype=np.int64)
+        u = (np.zeros((0, 2)) if self.filter == "box" else np.ascontiguousarray(
+            filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), self.filter)))
         radiance = np.zeros((n, 3))
         spent = np.zeros(len(STAGES))
+        settings = self._settings._replace(seed=int(seed))
         t1 = time.perf_counter()
-        rays = render_paths(self._tracer, self._scene, self._camera, self._settings, pixel, sample_index, x, u,
-                            lens, shutter, rr_key, radiance, spent, self._clock, self.wavefront)
+        rays = render_paths(self._tracer, self._scene, self._camera, settings, pixel, sample_index, x, u, radiance,
+                            spent, self._clock, self.wavefront)
         t2 = time.perf_counter()
         tm = self.timings
         for name, sec in zip(STAGES, spent):
