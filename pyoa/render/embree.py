@@ -137,7 +137,7 @@ class Scene:
         scenes: the default (a scene's ``integrator.robust_tracing``).
         Without it tracing is 1.4-1.6x faster (as Mitsuba 3 traces by
         default), but rays through a shared edge can pass between its two
-        triangles: about 2 % of the rays aimed exactly at the seams of the
+        triangles: 1 to 2.5 % of the rays aimed exactly at the seams of the
         bundled scenes leak, against none in robust mode
         (``tests/render/test_embree.py``; docs/rendering.md, "Tracing").
 

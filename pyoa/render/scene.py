@@ -45,7 +45,7 @@ Conventions are Mitsuba's:
   ``integrator.robust_tracing`` (default true) traces with Embree's robust
   mode, watertight at the edges that triangles share; false traces without
   it, as Mitsuba 3 does by default (its ``embree_use_robust_intersections``),
-  1.4-1.6x faster, but about 2 % of the rays aimed exactly at a shared edge
+  1.4-1.6x faster, but 1 to 2.5 % of the rays aimed exactly at a shared edge
   pass through it (docs/rendering.md, "Tracing"). The compiled shading
   follows it; the NumPy reference always traces robustly (embreex).
 * Materials: ``diffuse`` (``reflectance``, default 0.5 grey), ``ggx`` (a
