@@ -185,3 +185,57 @@ def test_fast_tracing_changes_only_rays_at_seams(tmp_path, name):
 def test_robust_tracing_must_be_a_boolean(tmp_path):
     with pytest.raises(ValueError, match=r"integrator\.robust_tracing"):
         load(_with_tracing(tmp_path, "cornell", "yes"))
+
+
+def test_numba_cache_follows_every_source_the_compiled_code_comes_from(tmp_path):
+    """numba's cache knows a function only by its own file: pyoa keeps the
+    compiled package's cache in a folder named after a digest of every
+    source its functions compile from, so editing any of them (a git pull
+    into an editable install) compiles again instead of reusing old code."""
+    import ast
+    import shutil
+    from pathlib import Path
+
+    import pyoa.render.compiled as pkg
+
+    root = Path(pkg.__file__).resolve().parent.parent
+    # every module of pyoa.render that the compiled package imports is a source
+    imported = set()
+    for path in (root / "compiled").glob("*.py"):
+        imported.add(f"compiled/{path.name}")
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level == 2:
+                names = [node.module] if node.module else [a.name for a in node.names]
+                imported.update(f"{n}.py" for n in names)
+    assert imported <= set(pkg.SOURCES), imported - set(pkg.SOURCES)
+    # the digest changes with any byte of any source
+    for rel in pkg.SOURCES:
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(root / rel, tmp_path / rel)
+    base = pkg.sources_digest(tmp_path)
+    assert base == pkg.sources_digest()
+    seen = {base}
+    for rel in pkg.SOURCES:
+        data = (tmp_path / rel).read_bytes()
+        (tmp_path / rel).write_bytes(data + b"\n")
+        seen.add(pkg.sources_digest(tmp_path))
+        (tmp_path / rel).write_bytes(data)
+    assert len(seen) == len(pkg.SOURCES) + 1
+    # the functions are cached under that folder, and numba's setting is restored for everyone else
+    code = textwrap.dedent("""
+        import os, pathlib
+        import numba.core.config as config
+        import pyoa.render.compiled as pkg
+        from pyoa.render.render import render
+        from pyoa.render.scene import load
+        assert config.CACHE_DIR == os.environ["NUMBA_CACHE_DIR"], config.CACHE_DIR
+        render(load("cornell"), sampler="bose", spp=4, width=4, height=4, shading="numba")
+        salted = pathlib.Path(pkg.cache_dir())
+        assert salted.name == "pyoa-render-" + pkg.sources_digest()[:16], salted
+        assert salted.parent == pathlib.Path(os.environ["NUMBA_CACHE_DIR"])
+        print(len(list(salted.rglob("integrator.render_paths-*.nbi"))))
+    """)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip() == "1"
