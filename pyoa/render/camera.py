@@ -22,6 +22,13 @@ from .geometry import concentric_disk, normalize
 FILTERS = ("box", "gaussian")
 
 
+def check_filter(filter) -> str:
+    """``filter`` if it is one of :data:`FILTERS`, else a ValueError naming them."""
+    if filter not in FILTERS:
+        raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
+    return filter
+
+
 def filter_offsets(u: np.ndarray, filter: str) -> np.ndarray:
     """Offsets in the pixel (``(N, 2)``, pixel units from its corner) for
     uniform ``u``, importance-sampling the pixel filter so that every sample

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..hashes import U32, hash_pair
 from . import bsdf
-from .camera import FILTERS, PerspectiveCamera, filter_offsets
+from .camera import PerspectiveCamera, check_filter, filter_offsets
 from .emitters import Emitters
 from .geometry import dot, frame, to_local, to_world
 from .layout import Layout
@@ -248,8 +248,7 @@ class Integrator:
     """
 
     def __init__(self, scene, layout: Layout, width: int, height: int, filter: str = "box"):
-        if filter not in FILTERS:
-            raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
+        check_filter(filter)
         self.scene, self.layout = scene, layout
         self.width, self.height, self.filter = width, height, filter
         #: Reach and growth of each triangle as traced (float32), for

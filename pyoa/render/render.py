@@ -23,7 +23,7 @@ from ..catalogue_types import MAX_UINT32, check_choice
 from ..samplers import ENV_MAX_BYTES, default_max_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
 from ..units import format_bytes
-from .camera import FILTERS
+from .camera import check_filter
 from .integrator import Integrator, Stats
 from .layout import MAX_DEPTH, Layout
 
@@ -175,8 +175,7 @@ def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: 
     limit = resolve_max_bytes(max_bytes)
     width, height = image_size(scene, width, height, limit)
     depth = _count("max_depth", max_depth, scene.max_depth, MAX_DEPTH)
-    if filter not in FILTERS:
-        raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
+    check_filter(filter)
     batch_paths = _count("batch_paths", batch_paths)
     if threads is not None:
         threads = _count("threads", threads)

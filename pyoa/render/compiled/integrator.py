@@ -471,11 +471,10 @@ class CompiledIntegrator:
     """
 
     def __init__(self, scene, layout, width, height, filter="box", packet=None):
-        from ..camera import FILTERS, PerspectiveCamera
+        from ..camera import PerspectiveCamera, check_filter
         from ..emitters import Emitters
 
-        if filter not in FILTERS:
-            raise ValueError(f"unknown pixel filter {filter!r}; valid: {', '.join(FILTERS)}")
+        check_filter(filter)
         self.scene, self.layout = scene, layout
         self.width, self.height, self.filter = width, height, filter
         self.packet = packet_width() if packet is None else packet
