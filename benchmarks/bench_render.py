@@ -168,11 +168,12 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     ``(calls, paths)``, ``calls`` a list of ``("hit", o, d, None)`` and
     ``("occ", o, d, dist)`` wavefronts in the order they are traced. The
     render runs the compiled integrator's own stages (camera rays,
-    ``shade``, ``add_visible``) one wavefront at a time from Python, as
+    ``shading.shade``, ``add_visible``) one wavefront at a time from Python, as
     ``render_paths`` runs them in one compiled call, and copies each
     wavefront's rays before tracing them."""
     from pyoa.render import embree
     from pyoa.render.compiled import integrator as ci
+    from pyoa.render.compiled import shading as csh
     from pyoa.render.integrator import U32, hash_pair, RR_KEY
     from pyoa.render.camera import filter_offsets
 
@@ -196,6 +197,7 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     calls = []
     size_w = integ.wavefront
     w = ci.new_wavefront(size_w)
+    scratch, lanes = np.empty(csh.SCRATCH), np.empty(csh.CHUNK, np.int64)
     for start in range(0, len(pixel), size_w):
         stop = min(start + size_w, len(pixel))
         m = stop - start
@@ -212,7 +214,7 @@ def record_rays(scene, args, size) -> tuple[list, int]:
                 break
             calls.append(("hit", w.o[:live].copy(), w.d[:live].copy(), None))
             embree.intersect(tr.scene, tr.hit, tr.packet, w.o[:live], w.d[:live], w.prim, w.t)
-            live, shadows = ci.shade(live, depth, sc, ps, x, sample, rr_key, w, radiance)
+            live, shadows = csh.shade(live, depth, sc, ps, x, sample, rr_key, w, radiance, scratch, lanes)
             if shadows:
                 calls.append(("occ", w.sh_o[:shadows].copy(), w.sh_d[:shadows].copy(), w.sh_dist[:shadows].copy()))
                 embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],

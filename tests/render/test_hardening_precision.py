@@ -173,7 +173,7 @@ def test_offsets_are_the_same_functions_in_both_shadings():
     """The compiled ``to_plane`` and ``offset_distance`` give the bits of the
     NumPy ones (the same operations in the same order), over coordinates
     from 1e-30 to 1e30."""
-    from pyoa.render.compiled import integrator as compiled
+    from pyoa.render.compiled import shading as compiled
     from pyoa.render.integrator import offset_distance, to_plane
 
     rng = np.random.default_rng(5)

@@ -29,7 +29,7 @@ _RENDER = Path(__file__).resolve().parent.parent
 #: it imports (``tests/render/test_compiled.py`` checks the list against the
 #: imports).
 SOURCES = ("compiled/__init__.py", "compiled/bsdf.py", "compiled/camera.py", "compiled/emitters.py",
-           "compiled/geometry.py", "compiled/integrator.py", "bsdf.py", "camera.py", "embree.py", "emitters.py",
+           "compiled/geometry.py", "compiled/integrator.py", "compiled/shading.py", "bsdf.py", "camera.py", "embree.py", "emitters.py",
            "integrator.py")
 
 
@@ -79,4 +79,4 @@ def _salted_cache():
 
 
 with _salted_cache():
-    from . import bsdf, camera, emitters, geometry, integrator  # noqa: E402,F401  (decorated here)
+    from . import bsdf, camera, emitters, geometry, integrator, shading  # noqa: F401  (decorated here)

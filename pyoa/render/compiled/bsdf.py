@@ -87,21 +87,20 @@ def ggx_sample_vndf(ox, oy, oz, alpha, u0, u1):
 
 
 @njit(**_JIT)
-def sample(kind, cr, cg, cb, alpha, ox, oy, oz, u0, u1):
-    """``(wi x, y, z, weight r, g, b, pdf, delta)``: :func:`pyoa.render.bsdf.sample` for one point."""
-    if oz <= 0.0:
-        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, kind == MIRROR
-    if kind == DIFFUSE:
-        x, y = concentric_disk(u0, u1)
-        z = math.sqrt(max(0.0, 1.0 - x * x - y * y))
-        inv = 1.0 / math.sqrt(x * x + y * y + z * z)
-        x, y, z = x * inv, y * inv, z * inv
-        if z > 0.0:
-            return x, y, z, cr, cg, cb, z / math.pi, False
-        return x, y, z, 0.0, 0.0, 0.0, 0.0, False
-    if kind == MIRROR:
-        return -ox, -oy, oz, cr, cg, cb, 0.0, True
-    # GGX
+def sample_diffuse(cr, cg, cb, u0, u1):
+    """The Lambertian lobe's sample (Malley's method), free of branches so
+    that a loop over lanes vectorizes: ``(wi x, y, z, weight r, g, b, pdf)``."""
+    x, y = concentric_disk(u0, u1)
+    z = math.sqrt(max(0.0, 1.0 - x * x - y * y))
+    inv = 1.0 / math.sqrt(x * x + y * y + z * z)
+    x, y, z = x * inv, y * inv, z * inv
+    up = z > 0.0
+    return (x, y, z, cr if up else 0.0, cg if up else 0.0, cb if up else 0.0, z / math.pi if up else 0.0)
+
+
+@njit(**_JIT)
+def sample_ggx(cr, cg, cb, alpha, ox, oy, oz, u0, u1):
+    """The GGX conductor's sample (visible normals): ``(wi x, y, z, weight r, g, b, pdf)``."""
     a = max(alpha, ALPHA_MIN)
     hx, hy, hz = ggx_sample_vndf(ox, oy, oz, a, u0, u1)
     c = 2.0 * (ox * hx + oy * hy + oz * hz)
@@ -111,8 +110,30 @@ def sample(kind, cr, cg, cb, alpha, ox, oy, oz, u0, u1):
     if dz > 0.0:
         fr, fg, fb, p = ggx_eval(cr, cg, cb, a, ox, oy, oz, dx, dy, dz)
         if p > 0.0 and math.isfinite(p):
-            return dx, dy, dz, fr / p, fg / p, fb / p, p, False
-    return dx, dy, dz, 0.0, 0.0, 0.0, 0.0, False
+            return dx, dy, dz, fr / p, fg / p, fb / p, p
+    return dx, dy, dz, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(**_JIT)
+def sample(kind, cr, cg, cb, alpha, ox, oy, oz, u0, u1):
+    """``(wi x, y, z, weight r, g, b, pdf, delta)``: :func:`pyoa.render.bsdf.sample` for one point."""
+    if oz <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, kind == MIRROR
+    if kind == DIFFUSE:
+        x, y, z, wr, wg, wb, pdf = sample_diffuse(cr, cg, cb, u0, u1)
+        return x, y, z, wr, wg, wb, pdf, False
+    if kind == MIRROR:
+        return -ox, -oy, oz, cr, cg, cb, 0.0, True
+    x, y, z, wr, wg, wb, pdf = sample_ggx(cr, cg, cb, alpha, ox, oy, oz, u0, u1)
+    return x, y, z, wr, wg, wb, pdf, False
+
+
+@njit(**_JIT)
+def evaluate_diffuse(cr, cg, cb, oz, iz):
+    """The Lambertian lobe's ``(f_cos r, g, b, pdf)``, free of branches."""
+    c = iz / math.pi
+    lit = oz > 0.0 and iz > 0.0
+    return cr * c if lit else 0.0, cg * c if lit else 0.0, cb * c if lit else 0.0, c if lit else 0.0
 
 
 @njit(**_JIT)
@@ -121,8 +142,7 @@ def evaluate(kind, cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz):
     if oz <= 0.0 or iz <= 0.0 or kind == MIRROR:
         return 0.0, 0.0, 0.0, 0.0
     if kind == DIFFUSE:
-        c = iz / math.pi
-        return cr * c, cg * c, cb * c, c
+        return evaluate_diffuse(cr, cg, cb, oz, iz)
     if kind == GGX:
         return ggx_eval(cr, cg, cb, max(alpha, ALPHA_MIN), ox, oy, oz, ix, iy, iz)
     return 0.0, 0.0, 0.0, 0.0

@@ -12,7 +12,7 @@ the GIL and never returns to Python until the batch is done: it takes the
 paths a wavefront of :data:`WAVEFRONT` lanes at a time (small enough for the
 lanes' state to stay in the CPU's caches), makes their camera rays, and for
 each bounce traces the closest hits (Embree packets), shades them
-(:func:`shade`: emission, the next-event candidate with its shadow ray, the
+(:func:`~pyoa.render.compiled.shading.shade`: emission, the next-event candidate with its shadow ray, the
 BSDF sample, roulette and the compaction of live lanes), traces the shadow
 rays and adds what they carry. The renderer's worker threads run batches
 side by side on every core; a lane's result depends only on its own row of
@@ -28,7 +28,6 @@ structures.
 from __future__ import annotations
 
 import ctypes
-import math
 import time
 from typing import NamedTuple
 
@@ -39,85 +38,15 @@ from numba.extending import intrinsic
 
 from .. import embree
 from .. import integrator as reference
-from ..bsdf import MIRROR
 from ..camera import filter_offsets
-from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR, Stats
-from .bsdf import evaluate, sample
+from ..integrator import RR_KEY, Stats
 from .camera import camera_rays
-from .emitters import sample_emitter
-from .geometry import frame
+from .shading import CHUNK, SCRATCH, hash_pair, hit_data, shade
 
 #: error_model="numpy": IEEE divisions, as the NumPy reference's (numba's
 #: default checks every division for zero and raises).
 _JIT = dict(nogil=True, cache=True, error_model="numpy")
 _INLINE = dict(_JIT, inline="always")
-
-
-@njit(**_INLINE)
-def _mix32(x):
-    """Wellons' lowbias32 on a uint32 held in an int64 (as pyoa.reference.mix32)."""
-    x ^= x >> 16
-    x = (x * 0x7FEB352D) & 0xFFFFFFFF
-    x ^= x >> 15
-    x = (x * 0x846CA68B) & 0xFFFFFFFF
-    x ^= x >> 16
-    return x
-
-
-@njit(**_INLINE)
-def hash_pair(a, b, key):
-    """``mix32(b ^ mix32(a ^ key))``, never 0 (as pyoa.reference.hash_pair)."""
-    h = _mix32((b & 0xFFFFFFFF) ^ _mix32((a & 0xFFFFFFFF) ^ key))
-    return key if h == 0 else h
-
-
-@njit(**_INLINE)
-def power_heuristic(f_pdf, g_pdf):
-    """Veach's power heuristic (beta = 2), as ``integrator.power_heuristic``."""
-    return f_pdf * f_pdf / max(f_pdf * f_pdf + g_pdf * g_pdf, 1e-300)
-
-
-@njit(**_INLINE)
-def emission_weight(depth, mis, pdf_light, prev_pdf, prev_delta):
-    """MIS weight of emission reached by a BSDF sample (as
-    ``Integrator.emission_weight``)."""
-    if depth == 1:
-        return 1.0
-    if not mis:
-        return 1.0 if prev_delta else 0.0  # without MIS only light sampling counts
-    return 1.0 if prev_delta else power_heuristic(prev_pdf, pdf_light)
-
-
-@njit(**_INLINE)
-def to_plane(px, py, pz, vx, vy, vz, mx, my, mz):
-    """The point ``p`` moved along the unit normal ``m`` onto the plane through
-    ``v``, as ``integrator.to_plane`` (the same operations in the same order,
-    so the same bits), whose docstring says why."""
-    h = (px - vx) * mx + (py - vy) * my + (pz - vz) * mz
-    return px - h * mx, py - h * my, pz - h * mz
-
-
-@njit(**_INLINE)
-def offset_distance(px, py, pz, nx, ny, nz, extent):
-    """How far along its unit normal ``n`` a ray leaves the surface point
-    ``p``: ``d = sum_k |n_k| e_k`` with the float32 error bound ``e_k =
-    ORIGIN_ERROR |p_k| + TEST_ERROR extent`` (pbrt-v4's offset of spawned ray
-    origins, 6.8.6), as ``integrator.offset_distance``, whose docstring
-    derives it; the same operations in the same order, so the same bits."""
-    s = TEST_ERROR * extent
-    return (abs(nx) * (ORIGIN_ERROR * abs(px) + s) + abs(ny) * (ORIGIN_ERROR * abs(py) + s)
-            + abs(nz) * (ORIGIN_ERROR * abs(pz) + s))
-
-
-@njit(**_INLINE)
-def russian_roulette(br, bg, bb, key, sample_index, depth):
-    """``(alive, beta r, g, b)``: survival with probability ``min(max beta,
-    0.95)`` from a hash of the path (as ``integrator.russian_roulette``)."""
-    q = min(max(br, bg, bb), 0.95)
-    h = hash_pair(key, sample_index * 64 + depth, RR_KEY)
-    if (h >> 8) * 2.0**-24 < q:
-        return True, br / q, bg / q, bb / q
-    return False, br, bg, bb
 
 
 class SceneData(NamedTuple):
@@ -139,6 +68,7 @@ class SceneData(NamedTuple):
     em_prob: np.ndarray  # (T,) probability of each triangle's choice (Emitters.prob)
     reach: np.ndarray  # (T,) triangle_reach: Embree's error grows with it ...
     growth: np.ndarray  # (T,) ... and, at a shadow segment's end, with its length times this
+    hit_data: np.ndarray  # (T, HIT_FIELDS) what the shading reads of a hit triangle (shading.hit_data)
 
 
 class CameraData(NamedTuple):
@@ -202,126 +132,6 @@ def new_wavefront(size):
                      np.empty(size), np.empty(size, np.bool_), np.empty(size, np.int64), np.empty(size),
                      np.empty((size, 3)), np.empty((size, 3)), np.empty(size), np.empty(size, np.int64),
                      np.empty((size, 3)), np.empty(size, np.bool_))
-
-
-@njit(**_JIT)
-def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance):
-    """One bounce of the ``n`` live lanes of the wavefront ``w``, whose
-    closest hits are ``w.prim``/``w.t``. The reference's formulas, with
-    products by a reciprocal where it divides several numbers by one (the
-    same values to rounding: divisions were a third of a bounce).
-
-    Adds the emission each ray sees (MIS-weighted) to ``radiance``; writes
-    the next-event shadow rays and their contributions (``w.sh_*``); samples
-    the BSDF, plays Russian roulette and compacts the surviving lanes, in
-    place, to the front of ``w.lane, o, d, beta, prev_pdf, prev_delta`` with
-    their new rays. Returns ``(live lanes, shadow rays)``. The sampler
-    columns of this depth are ``ps.columns[depth]`` (-1 where the layout has
-    no such dimension). Hit points are moved onto their triangle's plane
-    (:func:`to_plane`, ``sc.normals``: the unit normals of the triangles as
-    traced) and new rays leave them by :func:`offset_distance` (``sc.reach``,
-    ``sc.growth``: as ``integrator.triangle_reach``).
-    """
-    max_depth, mis, rr_depth = ps.max_depth, ps.mis, ps.rr_depth
-    light_u, light_v = ps.columns[depth, 0], ps.columns[depth, 1]
-    bsdf_u, bsdf_v = ps.columns[depth, 2], ps.columns[depth, 3]
-    verts, normals, areas, material, emission = sc.verts, sc.normals, sc.areas, sc.material, sc.emission
-    kinds, colors, alphas, em, em_cdf, em_prob = sc.kinds, sc.colors, sc.alphas, sc.em, sc.em_cdf, sc.em_prob
-    reach, growth = sc.reach, sc.growth
-    lane, o, d, beta, prev_pdf, prev_delta, prim, t = w.lane, w.o, w.d, w.beta, w.prev_pdf, w.prev_delta, w.prim, w.t
-    sh_o, sh_d, sh_dist, sh_lane, sh_c = w.sh_o, w.sh_d, w.sh_dist, w.sh_lane, w.sh_c
-    live, shadows = 0, 0
-    for i in range(n):
-        tri = prim[i]
-        if tri < 0:
-            continue  # the ray left the scene
-        li = lane[i]
-        dx, dy, dz = d[i, 0], d[i, 1], d[i, 2]
-        ti = t[i]
-        px, py, pz = to_plane(o[i, 0] + ti * dx, o[i, 1] + ti * dy, o[i, 2] + ti * dz,
-                              verts[tri, 0, 0], verts[tri, 0, 1], verts[tri, 0, 2],
-                              normals[tri, 0], normals[tri, 1], normals[tri, 2])
-        nx, ny, nz = normals[tri, 0], normals[tri, 1], normals[tri, 2]
-        br, bg, bb = beta[i, 0], beta[i, 1], beta[i, 2]
-        # emission seen by this ray (emitters are one-sided)
-        cos_l = -(nx * dx + ny * dy + nz * dz)
-        er, eg, eb = emission[tri, 0], emission[tri, 1], emission[tri, 2]
-        if cos_l > 0 and (er != 0.0 or eg != 0.0 or eb != 0.0):
-            pdf_light = em_prob[tri] / areas[tri] * ti * ti / max(cos_l, 1e-12)
-            w = emission_weight(depth, mis, pdf_light, prev_pdf[i], prev_delta[i])
-            radiance[li, 0] += br * er * w
-            radiance[li, 1] += bg * eg * w
-            radiance[li, 2] += bb * eb * w
-        if depth == max_depth:
-            continue
-        eps = offset_distance(px, py, pz, nx, ny, nz, reach[tri])  # new rays leave p this far
-        # shading frame facing the incoming ray (two-sided surfaces)
-        if nx * dx + ny * dy + nz * dz > 0:
-            sx, sy, sz = -nx, -ny, -nz
-        else:
-            sx, sy, sz = nx, ny, nz
-        (tx, ty, tz), (bx, by, bz) = frame(sx, sy, sz)
-        wox, woy, woz = -(dx * tx + dy * ty + dz * tz), -(dx * bx + dy * by + dz * bz), -(dx * sx + dy * sy + dz * sz)
-        woz = max(woz, 1e-9)
-        mat = material[tri]
-        kind, alpha = kinds[mat], alphas[mat]
-        cr, cg, cb = colors[mat, 0], colors[mat, 1], colors[mat, 2]
-        # next-event estimation: one point on an emitter
-        if kind != MIRROR:
-            etri, qx, qy, qz, mx, my, mz, pdf_area = sample_emitter(
-                em, em_cdf, em_prob, verts, normals, areas,
-                np.float64(x[li, light_u]), np.float64(x[li, light_v]))
-            vx, vy, vz = qx - px, qy - py, qz - pz
-            dist = math.sqrt(vx * vx + vy * vy + vz * vz)
-            inv = 1.0 / max(dist, 1e-12)  # one division, three products (the reference divides thrice)
-            wx, wy, wz = vx * inv, vy * inv, vz * inv
-            cos_q = -(mx * wx + my * wy + mz * wz)
-            fr, fg, fb, pdf_b = evaluate(kind, cr, cg, cb, alpha, wox, woy, woz,
-                                         wx * tx + wy * ty + wz * tz, wx * bx + wy * by + wz * bz,
-                                         wx * sx + wy * sy + wz * sz)
-            pdf_l = pdf_area * dist * dist / max(cos_q, 1e-12)
-            if cos_q > 0 and (fr > 0 or fg > 0 or fb > 0):
-                # from p + eps n to q + eps_q n_q, each moved off its surface
-                # by its own float32 error bound (q's: the end of a segment of
-                # length dist), not shortened further (as the reference)
-                side = eps if wx * sx + wy * sy + wz * sz > 0 else -eps
-                ax, ay, az = px + side * sx, py + side * sy, pz + side * sz
-                eq = offset_distance(qx, qy, qz, mx, my, mz, dist * growth[etri] + reach[etri])
-                gx, gy, gz = qx + eq * mx - ax, qy + eq * my - ay, qz + eq * mz - az
-                seg = math.sqrt(gx * gx + gy * gy + gz * gz)
-                inv = 1.0 / max(seg, 1e-12)
-                # power_heuristic(pdf_l, pdf_b) / pdf_l in one division
-                f = pdf_l / max(pdf_l * pdf_l + pdf_b * pdf_b, 1e-300) if mis else 1.0 / pdf_l
-                sh_o[shadows, 0], sh_o[shadows, 1], sh_o[shadows, 2] = ax, ay, az
-                sh_d[shadows, 0], sh_d[shadows, 1], sh_d[shadows, 2] = gx * inv, gy * inv, gz * inv
-                sh_dist[shadows] = seg
-                sh_lane[shadows] = li
-                sh_c[shadows, 0] = br * fr * emission[etri, 0] * f
-                sh_c[shadows, 1] = bg * fg * emission[etri, 1] * f
-                sh_c[shadows, 2] = bb * fb * emission[etri, 2] * f
-                shadows += 1
-        # continue the path with a BSDF sample
-        if not (mis or depth < max_depth - 1):
-            continue
-        ix, iy, iz, wr, wg, wb, pdf, delta = sample(kind, cr, cg, cb, alpha, wox, woy, woz,
-                                                    np.float64(x[li, bsdf_u]), np.float64(x[li, bsdf_v]))
-        br, bg, bb = br * wr, bg * wg, bb * wb
-        alive = br > 0 or bg > 0 or bb > 0
-        if alive and depth >= rr_depth:
-            alive, br, bg, bb = russian_roulette(br, bg, bb, rr_key[li], sample_index[li], depth)
-        if not alive:
-            continue
-        ox_, oy_, oz_ = ix * tx + iy * bx + iz * sx, ix * ty + iy * by + iz * sy, ix * tz + iy * bz + iz * sz
-        side = eps if ox_ * sx + oy_ * sy + oz_ * sz > 0 else -eps
-        j = live
-        lane[j] = li
-        o[j, 0], o[j, 1], o[j, 2] = px + side * sx, py + side * sy, pz + side * sz
-        d[j, 0], d[j, 1], d[j, 2] = ox_, oy_, oz_
-        beta[j, 0], beta[j, 1], beta[j, 2] = br, bg, bb
-        prev_pdf[j] = pdf
-        prev_delta[j] = delta
-        live += 1
-    return live, shadows
 
 
 @njit(**_JIT)
@@ -389,6 +199,7 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, cl
     n = pixel.shape[0]
     size = max(1, min(wavefront, n))
     w = new_wavefront(size)
+    scratch, lanes = np.empty(SCRATCH), np.empty(CHUNK, np.int64)
     ts = np.zeros(2, np.int64)
     rays = 0
     t0 = _now(clock, ts)
@@ -430,7 +241,7 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, cl
             embree.intersect(tr.scene, tr.hit, tr.packet, w.o[:live], w.d[:live], w.prim, w.t)
             rays += live
             t2 = _now(clock, ts)
-            live, shadows = shade(live, depth, sc, ps, x, sample_index, rr_key, w, radiance)
+            live, shadows = shade(live, depth, sc, ps, x, sample_index, rr_key, w, radiance, scratch, lanes)
             t3 = _now(clock, ts)
             if shadows:
                 embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],
@@ -486,11 +297,14 @@ class CompiledIntegrator:
         self._tracer = Tracer(self._rtc.handle, hit, occ, self.packet)
         m, em = scene.materials, Emitters(scene)
         c = np.ascontiguousarray
+        verts, kinds, material = c(scene.triangles, dtype=np.float64), c(m.kind, dtype=np.int64), c(scene.material,
+                                                                                               dtype=np.int64)
         self._scene = SceneData(
-            verts=c(scene.triangles, dtype=np.float64), normals=c(scene.normals), areas=c(scene.areas),
-            material=c(scene.material, dtype=np.int64), emission=c(scene.emission),
-            kinds=c(m.kind, dtype=np.int64), colors=c(m.color), alphas=c(m.alpha),
-            em=c(em.index, dtype=np.int64), em_cdf=c(em.cdf), em_prob=c(em.prob), reach=c(reach), growth=c(growth))
+            verts=verts, normals=c(scene.normals), areas=c(scene.areas), material=material,
+            emission=c(scene.emission), kinds=kinds, colors=c(m.color), alphas=c(m.alpha),
+            em=c(em.index, dtype=np.int64), em_cdf=c(em.cdf), em_prob=c(em.prob), reach=c(reach), growth=c(growth),
+            hit_data=hit_data(verts, scene.normals, scene.emission, em.prob, scene.areas, reach, material, kinds,
+                              m.alpha, m.color))
         cam = PerspectiveCamera(scene.camera, width, height)
         self._camera = CameraData(width, height, cam.tan_x, cam.tan_y, c(cam.rot), c(cam.pos), cam.aperture,
                                   cam.focus_distance, c(cam.motion))

@@ -1,0 +1,464 @@
+"""One bounce of a wavefront, shaded in lanes (structure of arrays) so that
+the compiler vectorizes it.
+
+:func:`shade` takes the live entries of a wavefront :data:`CHUNK` at a time.
+For each chunk it
+
+1. gathers the entries whose ray hit something into a scratch array, one row
+   per quantity (:func:`gather`, a scalar loop: the triangle's and the
+   material's data are indexed by the hit, which a vector loop would read
+   with slow gathers);
+2. computes the hit point, the emission the ray sees, the shading frame and
+   the offset of new rays for all those lanes at once (:func:`head`);
+3. adds the emission to the paths' radiance and chooses each lane's point on
+   an emitter (:func:`emit_and_choose`: a binary search per lane, scalar);
+4. computes the next-event directions and the Lambertian values
+   (:func:`light_directions`), the other BSDFs one lane at a time
+   (:func:`evaluate_others`), then the shadow rays and what they carry
+   (:func:`shadow_rays`), and compacts them for Embree (:func:`emit_shadows`);
+5. samples the Lambertian and mirror lobes (:func:`sample_lobes`), the other
+   BSDFs one lane at a time (:func:`sample_others`), makes the new rays
+   (:func:`new_rays`), and plays Russian roulette while compacting the
+   surviving lanes to the front of the wavefront (:func:`survivors`).
+
+Steps 2, 4 and 5's lane loops contain no branches that depend on a lane
+(selects instead) and touch only the scratch, laid out as one flat array
+with rows :data:`CHUNK` apart: with the distance between rows a compile-time
+constant, LLVM proves that the rows do not overlap and vectorizes the loops
+without run-time alias checks (with a 2-D array whose row stride is only
+known at run time it gave up; ``tests/render/test_compiled.py`` reads the
+assembly). Each lane does the same operations in the same order as the
+one-lane-at-a-time form of the reference, and without fast-math flags
+vector instructions round exactly as scalar ones, so the image is the same
+to the bit whatever the chunk, wavefront or vector width.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..bsdf import DIFFUSE, MIRROR
+from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR
+from .bsdf import evaluate, evaluate_diffuse, sample, sample_diffuse
+from .emitters import sample_emitter
+from .geometry import frame
+
+#: error_model="numpy": IEEE divisions, as the NumPy reference's (numba's
+#: default checks every division for zero and raises, which also stops the
+#: vectorizer).
+_JIT = dict(nogil=True, cache=True, error_model="numpy")
+_INLINE = dict(_JIT, inline="always")
+
+#: Lanes shaded together: the rows of the scratch array. 256 lanes of its
+#: 105 rows are 217 KiB, within a core's L2 cache.
+CHUNK = 256
+#: Distance between the scratch's rows: CHUNK plus one cache line, because rows a
+#: power of two apart fall into the same few sets of the L1 cache and evict
+#: each other (the loops touch 20-40 rows at a time).
+ROW = CHUNK + 8
+
+#: The scratch's rows (each ``CHUNK`` float64 values; flags and material
+#: kinds are stored as 0.0/1.0 and small whole numbers). Inputs, copied by
+#: :func:`gather`:
+(DX, DY, DZ, OX, OY, OZ, T, V0X, V0Y, V0Z, NX, NY, NZ, ER, EG, EB, PDF_AREA_HIT, REACH, KIND, ALPHA, CR, CG, CB,
+ BR, BG, BB, PREV_PDF, PREV_DELTA, LIGHT_U, LIGHT_V, BSDF_U, BSDF_V,
+ # the hit (head): point, shading normal, tangents, outgoing direction (local), offset, emission seen
+ PX, PY, PZ, SX, SY, SZ, TX, TY, TZ, BX, BY, BZ, WOX, WOY, WOZ, EPS, SEEN, LE_R, LE_G, LE_B,
+ # the point chosen on an emitter (emit_and_choose)
+ QX, QY, QZ, MX, MY, MZ, PDF_AREA, QE_R, QE_G, QE_B, Q_GROWTH, Q_REACH,
+ # next event: direction to the light, its cosine there, local direction, BSDF value and pdf
+ DIST, WX, WY, WZ, COS_Q, IX, IY, IZ, FR, FG, FB, PDF_B,
+ # the shadow ray and what it carries
+ SH_OK, SH_OX, SH_OY, SH_OZ, SH_DX, SH_DY, SH_DZ, SH_SEG, SH_R, SH_G, SH_B,
+ # the BSDF sample (local direction, weight, pdf, delta) and the new ray
+ NIX, NIY, NIZ, WR, WG, WB, PDF, DELTA, ALIVE, NBR, NBG, NBB, NOX, NOY, NOZ, NDX, NDY, NDZ) = (
+    k * ROW for k in range(105))
+#: Length of the scratch array.
+SCRATCH = 105 * ROW
+#: The per-triangle values :func:`gather` copies, in the order of the rows
+#: ``V0X .. CB`` (:func:`hit_data` makes them).
+HIT_FIELDS = 16
+
+
+def hit_data(verts, normals, emission, em_prob, areas, reach, material, kinds, alphas, colors):
+    """What the shading reads of the triangle a ray hit, one contiguous row
+    of :data:`HIT_FIELDS` float64 per triangle (two cache lines instead of
+    one from each of eight arrays): its first vertex, unit normal, emitted
+    radiance, the pdf per unit area of choosing a point on it
+    (``em_prob / area``, the reference's first operation on the two, so the
+    same bits), its offset scale (``reach``), and its material's kind,
+    roughness and colour."""
+    mat = np.asarray(material)
+    return np.ascontiguousarray(np.column_stack([
+        np.asarray(verts, np.float64)[:, 0], normals, emission, np.asarray(em_prob) / np.asarray(areas), reach,
+        np.asarray(kinds, np.float64)[mat], np.asarray(alphas)[mat], np.asarray(colors)[mat]]), dtype=np.float64)
+
+
+@njit(**_INLINE)
+def _mix32(x):
+    """Wellons' lowbias32 on a uint32 held in an int64 (as pyoa.reference.mix32)."""
+    x ^= x >> 16
+    x = (x * 0x7FEB352D) & 0xFFFFFFFF
+    x ^= x >> 15
+    x = (x * 0x846CA68B) & 0xFFFFFFFF
+    x ^= x >> 16
+    return x
+
+
+@njit(**_INLINE)
+def hash_pair(a, b, key):
+    """``mix32(b ^ mix32(a ^ key))``, never 0 (as pyoa.reference.hash_pair)."""
+    h = _mix32((b & 0xFFFFFFFF) ^ _mix32((a & 0xFFFFFFFF) ^ key))
+    return key if h == 0 else h
+
+
+@njit(**_INLINE)
+def power_heuristic(f_pdf, g_pdf):
+    """Veach's power heuristic (beta = 2), as ``integrator.power_heuristic``."""
+    return f_pdf * f_pdf / max(f_pdf * f_pdf + g_pdf * g_pdf, 1e-300)
+
+
+@njit(**_INLINE)
+def emission_weight(depth, mis, pdf_light, prev_pdf, prev_delta):
+    """MIS weight of emission reached by a BSDF sample (as
+    ``Integrator.emission_weight``)."""
+    if depth == 1:
+        return 1.0
+    if not mis:
+        return 1.0 if prev_delta else 0.0  # without MIS only light sampling counts
+    h = power_heuristic(prev_pdf, pdf_light)
+    return 1.0 if prev_delta else h
+
+
+@njit(**_INLINE)
+def to_plane(px, py, pz, vx, vy, vz, mx, my, mz):
+    """The point ``p`` moved along the unit normal ``m`` onto the plane through
+    ``v``, as ``integrator.to_plane`` (the same operations in the same order,
+    so the same bits), whose docstring says why."""
+    h = (px - vx) * mx + (py - vy) * my + (pz - vz) * mz
+    return px - h * mx, py - h * my, pz - h * mz
+
+
+@njit(**_INLINE)
+def offset_distance(px, py, pz, nx, ny, nz, extent):
+    """How far along its unit normal ``n`` a ray leaves the surface point
+    ``p``: ``d = sum_k |n_k| e_k`` with the float32 error bound ``e_k =
+    ORIGIN_ERROR |p_k| + TEST_ERROR extent`` (pbrt-v4's offset of spawned ray
+    origins, 6.8.6), as ``integrator.offset_distance``, whose docstring
+    derives it; the same operations in the same order, so the same bits."""
+    s = TEST_ERROR * extent
+    return (abs(nx) * (ORIGIN_ERROR * abs(px) + s) + abs(ny) * (ORIGIN_ERROR * abs(py) + s)
+            + abs(nz) * (ORIGIN_ERROR * abs(pz) + s))
+
+
+@njit(**_INLINE)
+def russian_roulette(br, bg, bb, key, sample_index, depth):
+    """``(alive, beta r, g, b)``: survival with probability ``min(max beta,
+    0.95)`` from a hash of the path (as ``integrator.russian_roulette``)."""
+    q = min(max(br, bg, bb), 0.95)
+    h = hash_pair(key, sample_index * 64 + depth, RR_KEY)
+    if (h >> 8) * 2.0**-24 < q:
+        return True, br / q, bg / q, bb / q
+    return False, br, bg, bb
+
+
+@njit(**_JIT)
+def gather(start, stop, depth, sc, ps, x, w, F, lanes):
+    """Copy the entries ``start .. stop - 1`` of the wavefront ``w`` whose ray
+    hit a triangle into the scratch ``F`` (their paths into ``lanes``), with
+    the triangle's and the material's data and the path's sampler values of
+    this depth. Returns how many."""
+    lu, lv, bu, bv = ps.columns[depth, 0], ps.columns[depth, 1], ps.columns[depth, 2], ps.columns[depth, 3]
+    h = 0
+    for i in range(start, stop):
+        tri = w.prim[i]
+        if tri < 0:
+            continue  # the ray left the scene
+        li = w.lane[i]
+        lanes[h] = li
+        F[DX + h], F[DY + h], F[DZ + h] = w.d[i, 0], w.d[i, 1], w.d[i, 2]
+        F[OX + h], F[OY + h], F[OZ + h] = w.o[i, 0], w.o[i, 1], w.o[i, 2]
+        F[T + h] = w.t[i]
+        for c in range(HIT_FIELDS):  # the triangle's row of sc.hit_data: V0X .. CB
+            F[V0X + c * ROW + h] = sc.hit_data[tri, c]
+        F[BR + h], F[BG + h], F[BB + h] = w.beta[i, 0], w.beta[i, 1], w.beta[i, 2]
+        F[PREV_PDF + h] = w.prev_pdf[i]
+        F[PREV_DELTA + h] = 1.0 if w.prev_delta[i] else 0.0
+        F[LIGHT_U + h] = np.float64(x[li, lu]) if lu >= 0 else 0.0
+        F[LIGHT_V + h] = np.float64(x[li, lv]) if lv >= 0 else 0.0
+        F[BSDF_U + h] = np.float64(x[li, bu]) if bu >= 0 else 0.0
+        F[BSDF_V + h] = np.float64(x[li, bv]) if bv >= 0 else 0.0
+        h += 1
+    return h
+
+
+@njit(**_JIT)
+def head(h, depth, mis, F):
+    """For the ``h`` gathered lanes (vectorized): the hit point moved onto
+    its triangle's plane (:func:`to_plane`), the emission the ray sees with
+    its MIS weight (emitters are one-sided), how far new rays leave the
+    point (:func:`offset_distance`), the shading frame facing the incoming
+    ray (two-sided surfaces) and the outgoing direction in it."""
+    for k in range(h):
+        dx, dy, dz = F[DX + k], F[DY + k], F[DZ + k]
+        nx, ny, nz = F[NX + k], F[NY + k], F[NZ + k]
+        ti = F[T + k]
+        px, py, pz = to_plane(F[OX + k] + ti * dx, F[OY + k] + ti * dy, F[OZ + k] + ti * dz,
+                              F[V0X + k], F[V0Y + k], F[V0Z + k], nx, ny, nz)
+        cos_l = -(nx * dx + ny * dy + nz * dz)
+        er, eg, eb = F[ER + k], F[EG + k], F[EB + k]
+        seen = (cos_l > 0) & ((er != 0.0) | (eg != 0.0) | (eb != 0.0))
+        pdf_light = F[PDF_AREA_HIT + k] * ti * ti / max(cos_l, 1e-12)
+        wt = emission_weight(depth, mis, pdf_light, F[PREV_PDF + k], F[PREV_DELTA + k] != 0.0)
+        F[SEEN + k] = 1.0 if seen else 0.0
+        F[LE_R + k], F[LE_G + k], F[LE_B + k] = F[BR + k] * er * wt, F[BG + k] * eg * wt, F[BB + k] * eb * wt
+        F[EPS + k] = offset_distance(px, py, pz, nx, ny, nz, F[REACH + k])
+        back = nx * dx + ny * dy + nz * dz > 0
+        sx, sy, sz = -nx if back else nx, -ny if back else ny, -nz if back else nz
+        (tx, ty, tz), (bx, by, bz) = frame(sx, sy, sz)
+        F[PX + k], F[PY + k], F[PZ + k] = px, py, pz
+        F[SX + k], F[SY + k], F[SZ + k] = sx, sy, sz
+        F[TX + k], F[TY + k], F[TZ + k] = tx, ty, tz
+        F[BX + k], F[BY + k], F[BZ + k] = bx, by, bz
+        F[WOX + k] = -(dx * tx + dy * ty + dz * tz)
+        F[WOY + k] = -(dx * bx + dy * by + dz * bz)
+        F[WOZ + k] = max(-(dx * sx + dy * sy + dz * sz), 1e-9)
+
+
+@njit(**_JIT)
+def emit_and_choose(h, next_event, sc, F, lanes, radiance):
+    """Add the emission each lane's ray sees to its path's radiance and, when
+    ``next_event``, choose a point on an emitter by power for each lane
+    whose BSDF is not a mirror (:func:`sample_emitter`, a binary search)."""
+    for k in range(h):
+        li = lanes[k]
+        if F[SEEN + k] != 0.0:
+            radiance[li, 0] += F[LE_R + k]
+            radiance[li, 1] += F[LE_G + k]
+            radiance[li, 2] += F[LE_B + k]
+        if next_event and F[KIND + k] != MIRROR:
+            etri, qx, qy, qz, mx, my, mz, pdf_area = sample_emitter(
+                sc.em, sc.em_cdf, sc.em_prob, sc.verts, sc.normals, sc.areas, F[LIGHT_U + k], F[LIGHT_V + k])
+            F[QX + k], F[QY + k], F[QZ + k] = qx, qy, qz
+            F[MX + k], F[MY + k], F[MZ + k] = mx, my, mz
+            F[PDF_AREA + k] = pdf_area
+            F[QE_R + k], F[QE_G + k], F[QE_B + k] = sc.emission[etri, 0], sc.emission[etri, 1], sc.emission[etri, 2]
+            F[Q_GROWTH + k], F[Q_REACH + k] = sc.growth[etri], sc.reach[etri]
+        else:
+            # no light sample: values that keep the lane's arithmetic finite
+            F[QX + k], F[QY + k], F[QZ + k] = F[PX + k] + 1.0, F[PY + k], F[PZ + k]
+            F[MX + k], F[MY + k], F[MZ + k] = -1.0, 0.0, 0.0
+            F[PDF_AREA + k], F[Q_GROWTH + k], F[Q_REACH + k] = 0.0, 0.0, 0.0
+            F[QE_R + k], F[QE_G + k], F[QE_B + k] = 0.0, 0.0, 0.0
+
+
+@njit(**_JIT)
+def light_directions(h, F):
+    """For each lane (vectorized): the unit direction ``w`` to its point on an
+    emitter, the distance, the cosine there, ``w`` in the shading frame and
+    the Lambertian ``(f_cos, pdf)`` of it (the other BSDFs:
+    :func:`evaluate_others`)."""
+    for k in range(h):
+        px, py, pz = F[PX + k], F[PY + k], F[PZ + k]
+        vx, vy, vz = F[QX + k] - px, F[QY + k] - py, F[QZ + k] - pz
+        dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+        inv = 1.0 / max(dist, 1e-12)  # one division, three products (the reference divides thrice)
+        wx, wy, wz = vx * inv, vy * inv, vz * inv
+        iz = wx * F[SX + k] + wy * F[SY + k] + wz * F[SZ + k]
+        F[DIST + k] = dist
+        F[WX + k], F[WY + k], F[WZ + k] = wx, wy, wz
+        F[COS_Q + k] = -(F[MX + k] * wx + F[MY + k] * wy + F[MZ + k] * wz)
+        F[IX + k] = wx * F[TX + k] + wy * F[TY + k] + wz * F[TZ + k]
+        F[IY + k] = wx * F[BX + k] + wy * F[BY + k] + wz * F[BZ + k]
+        F[IZ + k] = iz
+        F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = evaluate_diffuse(F[CR + k], F[CG + k], F[CB + k],
+                                                                        F[WOZ + k], iz)
+
+
+@njit(**_JIT)
+def evaluate_others(h, F):
+    """``(f_cos, pdf)`` of the next-event direction for the lanes whose BSDF
+    is neither Lambertian nor a mirror, one lane at a time (:func:`evaluate`)."""
+    for k in range(h):
+        kind = F[KIND + k]
+        if kind != DIFFUSE and kind != MIRROR:
+            F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = evaluate(
+                np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k], F[WOZ + k],
+                F[IX + k], F[IY + k], F[IZ + k])
+
+
+@njit(**_JIT)
+def shadow_rays(h, mis, F):
+    """For each lane (vectorized): whether it has a shadow ray (a light sample
+    facing it that the BSDF does not reject), the ray from ``p + eps n`` to
+    ``q + eps_q n_q``, each moved off its surface by its own float32 error
+    bound (``q``'s: the end of a segment of length ``dist``), not shortened
+    further (as the reference), and what it carries: ``beta f_cos L_e w /
+    pdf_light`` with the power heuristic's ``w`` (one division for both)."""
+    for k in range(h):
+        dist, cos_q = F[DIST + k], F[COS_Q + k]
+        fr, fg, fb, pdf_b = F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k]
+        pdf_l = F[PDF_AREA + k] * dist * dist / max(cos_q, 1e-12)
+        ok = (F[KIND + k] != MIRROR) & (cos_q > 0) & ((fr > 0) | (fg > 0) | (fb > 0))
+        eps = F[EPS + k]
+        side = eps if F[IZ + k] > 0 else -eps
+        sx, sy, sz = F[SX + k], F[SY + k], F[SZ + k]
+        ax, ay, az = F[PX + k] + side * sx, F[PY + k] + side * sy, F[PZ + k] + side * sz
+        qx, qy, qz, mx, my, mz = F[QX + k], F[QY + k], F[QZ + k], F[MX + k], F[MY + k], F[MZ + k]
+        eq = offset_distance(qx, qy, qz, mx, my, mz, dist * F[Q_GROWTH + k] + F[Q_REACH + k])
+        gx, gy, gz = qx + eq * mx - ax, qy + eq * my - ay, qz + eq * mz - az
+        seg = math.sqrt(gx * gx + gy * gy + gz * gz)
+        inv = 1.0 / max(seg, 1e-12)
+        # power_heuristic(pdf_l, pdf_b) / pdf_l in one division
+        f = pdf_l / max(pdf_l * pdf_l + pdf_b * pdf_b, 1e-300) if mis else 1.0 / pdf_l
+        F[SH_OK + k] = 1.0 if ok else 0.0
+        F[SH_OX + k], F[SH_OY + k], F[SH_OZ + k] = ax, ay, az
+        F[SH_DX + k], F[SH_DY + k], F[SH_DZ + k] = gx * inv, gy * inv, gz * inv
+        F[SH_SEG + k] = seg
+        F[SH_R + k] = F[BR + k] * fr * F[QE_R + k] * f
+        F[SH_G + k] = F[BG + k] * fg * F[QE_G + k] * f
+        F[SH_B + k] = F[BB + k] * fb * F[QE_B + k] * f
+
+
+@njit(**_JIT)
+def emit_shadows(h, F, lanes, w, shadows):
+    """Append the lanes' shadow rays to the wavefront's (``w.sh_*``) from
+    index ``shadows``; returns the new count."""
+    for k in range(h):
+        if F[SH_OK + k] != 0.0:
+            j = shadows
+            w.sh_o[j, 0], w.sh_o[j, 1], w.sh_o[j, 2] = F[SH_OX + k], F[SH_OY + k], F[SH_OZ + k]
+            w.sh_d[j, 0], w.sh_d[j, 1], w.sh_d[j, 2] = F[SH_DX + k], F[SH_DY + k], F[SH_DZ + k]
+            w.sh_dist[j] = F[SH_SEG + k]
+            w.sh_lane[j] = lanes[k]
+            w.sh_c[j, 0], w.sh_c[j, 1], w.sh_c[j, 2] = F[SH_R + k], F[SH_G + k], F[SH_B + k]
+            shadows += 1
+    return shadows
+
+
+@njit(**_JIT)
+def sample_lobes(h, F):
+    """The BSDF sample of each lane (vectorized) for the Lambertian and the
+    mirror lobes, chosen by a select (:func:`sample_diffuse`; a mirror
+    reflects ``wo``); the other kinds: :func:`sample_others`."""
+    for k in range(h):
+        ox, oy, oz = F[WOX + k], F[WOY + k], F[WOZ + k]
+        cr, cg, cb = F[CR + k], F[CG + k], F[CB + k]
+        x, y, z, wr, wg, wb, pdf = sample_diffuse(cr, cg, cb, F[BSDF_U + k], F[BSDF_V + k])
+        mirror = F[KIND + k] == MIRROR
+        below = oz <= 0.0  # as bsdf.sample (the frame faces the ray, so it does not happen)
+        F[NIX + k] = 0.0 if below else (-ox if mirror else x)
+        F[NIY + k] = 0.0 if below else (-oy if mirror else y)
+        F[NIZ + k] = 1.0 if below else (oz if mirror else z)
+        F[WR + k] = 0.0 if below else (cr if mirror else wr)
+        F[WG + k] = 0.0 if below else (cg if mirror else wg)
+        F[WB + k] = 0.0 if below else (cb if mirror else wb)
+        F[PDF + k] = 0.0 if below else (0.0 if mirror else pdf)
+        F[DELTA + k] = 1.0 if mirror else 0.0
+
+
+@njit(**_JIT)
+def sample_others(h, F):
+    """The BSDF sample of the lanes whose BSDF is neither Lambertian nor a
+    mirror, one lane at a time (:func:`sample`)."""
+    for k in range(h):
+        kind = F[KIND + k]
+        if kind != DIFFUSE and kind != MIRROR:
+            ix, iy, iz, wr, wg, wb, pdf, delta = sample(
+                np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k], F[WOZ + k],
+                F[BSDF_U + k], F[BSDF_V + k])
+            F[NIX + k], F[NIY + k], F[NIZ + k] = ix, iy, iz
+            F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = wr, wg, wb, pdf
+            F[DELTA + k] = 1.0 if delta else 0.0
+
+
+@njit(**_JIT)
+def new_rays(h, F):
+    """For each lane (vectorized): the throughput times the sample's weight,
+    whether it is still nonzero, and the new ray in world space leaving the
+    surface on the side it goes to."""
+    for k in range(h):
+        br, bg, bb = F[BR + k] * F[WR + k], F[BG + k] * F[WG + k], F[BB + k] * F[WB + k]
+        ix, iy, iz = F[NIX + k], F[NIY + k], F[NIZ + k]
+        sx, sy, sz = F[SX + k], F[SY + k], F[SZ + k]
+        dx = ix * F[TX + k] + iy * F[BX + k] + iz * sx
+        dy = ix * F[TY + k] + iy * F[BY + k] + iz * sy
+        dz = ix * F[TZ + k] + iy * F[BZ + k] + iz * sz
+        eps = F[EPS + k]
+        side = eps if dx * sx + dy * sy + dz * sz > 0 else -eps
+        F[ALIVE + k] = 1.0 if (br > 0) | (bg > 0) | (bb > 0) else 0.0
+        F[NBR + k], F[NBG + k], F[NBB + k] = br, bg, bb
+        F[NOX + k], F[NOY + k], F[NOZ + k] = F[PX + k] + side * sx, F[PY + k] + side * sy, F[PZ + k] + side * sz
+        F[NDX + k], F[NDY + k], F[NDZ + k] = dx, dy, dz
+
+
+@njit(**_JIT)
+def survivors(h, depth, rr_depth, F, lanes, sample_index, rr_key, w, live):
+    """Russian roulette (from depth ``rr_depth``) for the lanes whose
+    throughput is nonzero, and the survivors' new rays, throughputs and
+    pdfs written to the wavefront from entry ``live`` (compaction: the
+    entries written were all gathered before). Returns the new count."""
+    for k in range(h):
+        if F[ALIVE + k] == 0.0:
+            continue
+        li = lanes[k]
+        br, bg, bb = F[NBR + k], F[NBG + k], F[NBB + k]
+        if depth >= rr_depth:
+            alive, br, bg, bb = russian_roulette(br, bg, bb, rr_key[li], sample_index[li], depth)
+            if not alive:
+                continue
+        j = live
+        w.lane[j] = li
+        w.o[j, 0], w.o[j, 1], w.o[j, 2] = F[NOX + k], F[NOY + k], F[NOZ + k]
+        w.d[j, 0], w.d[j, 1], w.d[j, 2] = F[NDX + k], F[NDY + k], F[NDZ + k]
+        w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = br, bg, bb
+        w.prev_pdf[j] = F[PDF + k]
+        w.prev_delta[j] = F[DELTA + k] != 0.0
+        live += 1
+    return live
+
+
+@njit(**_JIT)
+def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance, F, lanes):
+    """One bounce of the ``n`` live entries of the wavefront ``w``, whose
+    closest hits are ``w.prim``/``w.t``, :data:`CHUNK` lanes at a time (the
+    steps of this module's docstring; ``F`` the scratch, :data:`SCRATCH`
+    float64, ``lanes`` :data:`CHUNK` int64). The reference's formulas, with
+    products by a reciprocal where it divides several numbers by one (the
+    same values to rounding: divisions were a third of a bounce).
+
+    Adds the emission each ray sees (MIS-weighted) to ``radiance``; writes
+    the next-event shadow rays and their contributions (``w.sh_*``); samples
+    the BSDF, plays Russian roulette and compacts the surviving lanes, in
+    place, to the front of ``w.lane, o, d, beta, prev_pdf, prev_delta`` with
+    their new rays. Returns ``(live lanes, shadow rays)``. The sampler
+    columns of this depth are ``ps.columns[depth]`` (-1 where the layout has
+    no such dimension). Hit points are moved onto their triangle's plane
+    (:func:`to_plane`, ``sc.normals``: the unit normals of the triangles as
+    traced) and new rays leave them by :func:`offset_distance` (``sc.reach``,
+    ``sc.growth``: as ``integrator.triangle_reach``).
+    """
+    next_event = depth < ps.max_depth
+    # a new ray when it can find emission (MIS) or feed a later light sample
+    extend = next_event and (ps.mis or depth < ps.max_depth - 1)
+    live, shadows = 0, 0
+    for start in range(0, n, CHUNK):
+        h = gather(start, min(start + CHUNK, n), depth, sc, ps, x, w, F, lanes)
+        head(h, depth, ps.mis, F)
+        emit_and_choose(h, next_event, sc, F, lanes, radiance)
+        if not next_event:
+            continue
+        light_directions(h, F)
+        evaluate_others(h, F)
+        shadow_rays(h, ps.mis, F)
+        shadows = emit_shadows(h, F, lanes, w, shadows)
+        if not extend:
+            continue
+        sample_lobes(h, F)
+        sample_others(h, F)
+        new_rays(h, F)
+        live = survivors(h, depth, ps.rr_depth, F, lanes, sample_index, rr_key, w, live)
+    return live, shadows
