@@ -173,6 +173,7 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     wavefront's rays before tracing them."""
     from pyoa.render import embree
     from pyoa.render.compiled import integrator as ci
+    from pyoa.render.compiled import camera as ccam
     from pyoa.render.compiled import shading as csh
     from pyoa.render.integrator import U32, hash_pair, RR_KEY
     from pyoa.render.camera import filter_offsets
@@ -189,8 +190,6 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     pixel = np.repeat(np.arange(n_pix), p.sampler.spp)
     sample = np.tile(np.arange(p.sampler.spp), n_pix).astype(np.int64)
     u = np.ascontiguousarray(filter_offsets(x[:, list(L.pair("pixel"))].astype(np.float64), integ.filter))
-    lens = x[:, list(L.pair("lens"))].astype(np.float64) if L.lens else np.zeros((0, 2))
-    shutter = x[:, L.index("time")].astype(np.float64) if L.time else np.zeros(0)
     rr_key = hash_pair(U32(p.sampler.seed), pixel.astype(U32), RR_KEY).astype(np.int64)
     radiance = np.zeros((len(pixel), 3))
     tr, sc, cam, ps = integ._tracer, integ._scene, integ._camera, integ._settings
@@ -198,12 +197,13 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     size_w = integ.wavefront
     w = ci.new_wavefront(size_w)
     scratch, lanes = np.empty(csh.SCRATCH), np.empty(csh.CHUNK, np.int64)
+    cam_scratch = np.empty(ccam.SCRATCH)
     for start in range(0, len(pixel), size_w):
         stop = min(start + size_w, len(pixel))
         m = stop - start
-        ci.camera_rays(pixel[start:stop], u[start:stop], lens[start:stop] if len(lens) else lens,
-                       shutter[start:stop] if len(shutter) else shutter, cam.width, cam.height, cam.tan_x,
-                       cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, w.o, w.d)
+        ci.camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
+                       cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, cam_scratch, w.o,
+                       w.d)
         w.lane[:m] = np.arange(start, stop)
         w.beta[:m] = 1.0
         w.prev_pdf[:m] = 0.0

@@ -3,8 +3,9 @@
 arithmetic of a diffuse lane (direction to the light sample, cosines, pdfs,
 the MIS weight) written as a structure-of-arrays loop over a 512-lane
 wavefront, and what does it cost per lane in float64 and float32, against the
-same arithmetic in the array-of-structures layout that
-``pyoa.render.compiled.integrator.shade`` uses one lane at a time?
+same arithmetic in the array-of-structures layout that the compiled
+shading used one lane at a time before it was vectorized
+(``pyoa.render.compiled.shading`` is the result)?
 
 Prints ns per lane (Python's call overhead of ~1 ns per lane included) and
 counts the packed (``vdivp``, ``vsqrtp``, ``ymm``/``zmm``) instructions in the

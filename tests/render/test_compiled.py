@@ -242,7 +242,8 @@ def test_numba_cache_follows_every_source_the_compiled_code_comes_from(tmp_path)
 
 
 def test_lane_loops_vectorize():
-    """The shading's lane loops (pyoa.render.compiled.shading) are written so
+    """The lane loops of the shading and the camera
+    (pyoa.render.compiled.shading, pyoa.render.compiled.camera) are written so
     that LLVM vectorizes them: the assembly of each holds packed
     double-precision arithmetic. A change that stops the vectorizer (a
     branch on a lane's value, a second written array, rows a run-time
@@ -252,14 +253,19 @@ def test_lane_loops_vectorize():
 
     from numba import njit
 
+    from pyoa.render.compiled import camera as cam
     from pyoa.render.compiled import shading as sh
 
-    F = np.random.default_rng(0).random(sh.SCRATCH) + 0.5
-    calls = {"head": (sh.CHUNK, 2, True, F), "light_directions": (sh.CHUNK, F), "shadow_rays": (sh.CHUNK, True, F),
-             "sample_lobes": (sh.CHUNK, F), "new_rays": (sh.CHUNK, F)}
-    for name, args in calls.items():
+    rng = np.random.default_rng(0)
+    F = rng.random(sh.SCRATCH) + 0.5
+    C = rng.random(cam.SCRATCH)
+    calls = {"head": (sh, sh.CHUNK, 2, True, F), "light_directions": (sh, sh.CHUNK, F),
+             "shadow_rays": (sh, sh.CHUNK, True, F), "sample_lobes": (sh, sh.CHUNK, F), "new_rays": (sh, sh.CHUNK, F),
+             "_rays": (cam, cam.LANES, True, True, 64, 48, 0.5, 0.4, tuple(rng.random(9)), (1.0, 2.0, 3.0), 0.1, 2.0,
+                       (0.1, 0.2, 0.3), C)}
+    for name, (module, *args) in calls.items():
         # a copy compiled here: numba does not keep the assembly of cached code
-        f = njit(nogil=True, error_model="numpy")(getattr(sh, name).py_func)
+        f = njit(nogil=True, error_model="numpy")(getattr(module, name).py_func)
         f(*args)
         asm = f.inspect_asm(f.signatures[0])
         packed = len(re.findall(r"\bv?mulpd\b", asm))

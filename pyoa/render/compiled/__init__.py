@@ -2,7 +2,9 @@
 
 It mirrors the NumPy reference (:mod:`pyoa.render.integrator`,
 :mod:`pyoa.render.bsdf`, :mod:`pyoa.render.geometry`) function by function,
-one lane at a time, and traces through :mod:`pyoa.render.embree`. Chosen with
+the same operations in the same order, shades a bounce in vectorized loops
+over lanes (:mod:`~pyoa.render.compiled.shading`) and traces through
+:mod:`pyoa.render.embree`. Chosen with
 ``shading="numba"`` (the default), ``pyoa render --shading`` or
 ``PYOA_SHADING``.
 

@@ -1,12 +1,22 @@
 """Camera rays of :mod:`pyoa.render.camera`, compiled: the thin-lens
-perspective camera of :class:`~pyoa.render.camera.PerspectiveCamera`, one lane
-at a time (the filter's warp is :func:`~pyoa.render.camera.filter_offsets`,
-shared with the reference: it needs SciPy's inverse normal CDF)."""
+perspective camera of :class:`~pyoa.render.camera.PerspectiveCamera`
+(the filter's warp is :func:`~pyoa.render.camera.filter_offsets`, shared with
+the reference: it needs SciPy's inverse normal CDF).
+
+Rays are made :data:`LANES` at a time in a scratch of one row per quantity
+(as :mod:`pyoa.render.compiled.shading` shades, and for the same reasons: a
+loop over lanes that touches one flat array, rows a constant distance apart
+and one cache line more than a power of two, vectorizes): a scalar loop
+copies each lane's pixel column and row and its samples in, a vectorized one
+(:func:`_rays`) makes the rays, a scalar one copies them out. Each lane does
+the reference's operations in the same order, so the same bits.
+"""
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from .geometry import concentric_disk
@@ -14,31 +24,80 @@ from .geometry import concentric_disk
 #: error_model="numpy": IEEE divisions, as the NumPy reference's.
 _JIT = dict(nogil=True, cache=True, error_model="numpy")
 
+#: Rays made together, and the distance between the scratch's rows.
+LANES = 256
+ROW = LANES + 8
+#: The scratch's rows: the inputs (pixel column and row, offsets in the
+#: pixel, lens sample, time), then the ray.
+COL, LINE, U, V, LENS_U, LENS_V, TIME, OX, OY, OZ, DX, DY, DZ = (k * ROW for k in range(13))
+#: Length of the scratch (:func:`camera_rays`' ``scratch``).
+SCRATCH = 13 * ROW
+
 
 @njit(**_JIT)
-def camera_rays(pixel, u, lens, shutter, width, height, tan_x, tan_y, rot, pos, aperture, focus, motion, o, d):
-    """Camera rays of the lanes (as ``PerspectiveCamera.rays``) into ``o`` and
-    ``d``: ``u`` the offsets in the pixel (already warped by the filter),
-    ``lens`` the lens samples and ``shutter`` the times (empty arrays when the
-    camera has none)."""
-    has_lens, has_time = lens.shape[0] > 0, shutter.shape[0] > 0
-    for i in range(pixel.shape[0]):
-        fx = ((pixel[i] % width) + u[i, 0]) / width
-        fy = ((pixel[i] // width) + u[i, 1]) / height
+def _rays(m, has_lens, has_time, width, height, tan_x, tan_y, r, p, aperture, focus, mo, C):
+    """The rays of the ``m`` lanes of the scratch ``C`` (vectorized); ``r``,
+    ``p`` and ``mo`` are the rotation, position and motion as tuples of
+    scalars, so that the loop reads no array but the scratch."""
+    for j in range(m):
+        fx = (C[COL + j] + C[U + j]) / width
+        fy = (C[LINE + j] + C[V + j]) / height
         # Mitsuba's camera space: +z forward, +y up, +x towards the image's left.
         dx, dy, dz = (1.0 - 2.0 * fx) * tan_x, (1.0 - 2.0 * fy) * tan_y, 1.0
         ox, oy, oz = 0.0, 0.0, 0.0
         if has_lens:
-            lx, ly = concentric_disk(lens[i, 0], lens[i, 1])
+            lx, ly = concentric_disk(C[LENS_U + j], C[LENS_V + j])
             ox, oy = lx * aperture, ly * aperture
             dx, dy, dz = dx * focus - ox, dy * focus - oy, dz * focus
-        for k in range(3):
-            o[i, k] = ox * rot[k, 0] + oy * rot[k, 1] + oz * rot[k, 2] + pos[k]
-            if has_time:
-                o[i, k] = o[i, k] + shutter[i] * motion[k]
-        wx = dx * rot[0, 0] + dy * rot[0, 1] + dz * rot[0, 2]
-        wy = dx * rot[1, 0] + dy * rot[1, 1] + dz * rot[1, 2]
-        wz = dx * rot[2, 0] + dy * rot[2, 1] + dz * rot[2, 2]
+        o0 = ox * r[0] + oy * r[1] + oz * r[2] + p[0]
+        o1 = ox * r[3] + oy * r[4] + oz * r[5] + p[1]
+        o2 = ox * r[6] + oy * r[7] + oz * r[8] + p[2]
+        if has_time:
+            s = C[TIME + j]
+            o0, o1, o2 = o0 + s * mo[0], o1 + s * mo[1], o2 + s * mo[2]
+        C[OX + j], C[OY + j], C[OZ + j] = o0, o1, o2
+        wx = dx * r[0] + dy * r[1] + dz * r[2]
+        wy = dx * r[3] + dy * r[4] + dz * r[5]
+        wz = dx * r[6] + dy * r[7] + dz * r[8]
         n = math.sqrt(wx * wx + wy * wy + wz * wz)
         n = n if n > 0 else 1.0
-        d[i, 0], d[i, 1], d[i, 2] = wx / n, wy / n, wz / n
+        C[DX + j], C[DY + j], C[DZ + j] = wx / n, wy / n, wz / n
+
+
+@njit(**_JIT)
+def camera_rays(pixel, x, u, columns, width, height, tan_x, tan_y, rot, pos, aperture, focus, motion, scratch, o, d):
+    """Camera rays of the paths ``pixel[i]`` whose sampler rows are ``x[i]``
+    (as ``PerspectiveCamera.rays``) into ``o`` and ``d``. ``u`` are the
+    offsets in the pixel already warped by a Gaussian filter
+    (:func:`~pyoa.render.camera.filter_offsets`), empty for the box filter,
+    whose offsets are the samples themselves; ``columns`` the sampler
+    columns of the pixel offsets, the lens and the time (-1 where the camera
+    has none); ``scratch`` :data:`SCRATCH` float64."""
+    C = scratch
+    has_lens, has_time = columns[2] >= 0, columns[4] >= 0
+    r = (rot[0, 0], rot[0, 1], rot[0, 2], rot[1, 0], rot[1, 1], rot[1, 2], rot[2, 0], rot[2, 1], rot[2, 2])
+    p = (pos[0], pos[1], pos[2])
+    mo = (motion[0], motion[1], motion[2])
+    n = pixel.shape[0]
+    last, col, line = -1, 0, 0
+    for start in range(0, n, LANES):
+        m = min(LANES, n - start)
+        for j in range(m):
+            i = start + j
+            if pixel[i] != last:  # a pixel's samples are consecutive: one integer division per pixel
+                last = pixel[i]
+                col, line = last % width, last // width
+            C[COL + j], C[LINE + j] = col, line
+            if u.shape[0]:
+                C[U + j], C[V + j] = u[i, 0], u[i, 1]
+            else:
+                C[U + j], C[V + j] = np.float64(x[i, columns[0]]), np.float64(x[i, columns[1]])
+            if has_lens:
+                C[LENS_U + j], C[LENS_V + j] = np.float64(x[i, columns[2]]), np.float64(x[i, columns[3]])
+            if has_time:
+                C[TIME + j] = np.float64(x[i, columns[4]])
+        _rays(m, has_lens, has_time, width, height, tan_x, tan_y, r, p, aperture, focus, mo, C)
+        for j in range(m):
+            i = start + j
+            o[i, 0], o[i, 1], o[i, 2] = C[OX + j], C[OY + j], C[OZ + j]
+            d[i, 0], d[i, 1], d[i, 2] = C[DX + j], C[DY + j], C[DZ + j]

@@ -40,6 +40,7 @@ from .. import embree
 from .. import integrator as reference
 from ..camera import filter_offsets
 from ..integrator import RR_KEY, Stats
+from .camera import SCRATCH as CAMERA_SCRATCH
 from .camera import camera_rays
 from .shading import CHUNK, SCRATCH, hash_pair, hit_data, shade
 
@@ -206,27 +207,14 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, cl
     rr_key = np.empty(n, np.int64)
     for i in range(n):
         rr_key[i] = hash_pair(np.int64(ps.seed), pixel[i], RR_KEY)
-    cc = ps.camera_columns
-    uw = np.empty((size, 2))
-    lens = np.empty((size if cc[2] >= 0 else 0, 2))
-    shutter = np.empty(size if cc[4] >= 0 else 0)
+    cam_scratch = np.empty(CAMERA_SCRATCH)
     spent[0] += _now(clock, ts) - t0
     for start in range(0, n, size):
         m = min(size, n - start)
         stop = start + m
         t0 = _now(clock, ts)
-        for j in range(m):
-            i = start + j
-            if u.shape[0]:
-                uw[j, 0], uw[j, 1] = u[i, 0], u[i, 1]
-            else:
-                uw[j, 0], uw[j, 1] = np.float64(x[i, cc[0]]), np.float64(x[i, cc[1]])
-            if lens.shape[0]:
-                lens[j, 0], lens[j, 1] = np.float64(x[i, cc[2]]), np.float64(x[i, cc[3]])
-            if shutter.shape[0]:
-                shutter[j] = np.float64(x[i, cc[4]])
-        camera_rays(pixel[start:stop], uw[:m], lens[:m], shutter[:m], cam.width, cam.height, cam.tan_x,
-                    cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, w.o, w.d)
+        camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
+                    cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, cam_scratch, w.o, w.d)
         for j in range(m):
             w.lane[j] = start + j
             w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = 1.0, 1.0, 1.0
