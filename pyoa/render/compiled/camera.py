@@ -30,8 +30,8 @@ ROW = LANES + 8
 #: The scratch's rows: the inputs (pixel column and row, offsets in the
 #: pixel, lens sample, time), then the ray.
 COL, LINE, U, V, LENS_U, LENS_V, TIME, OX, OY, OZ, DX, DY, DZ = (k * ROW for k in range(13))
-#: Length of the scratch (:func:`camera_rays`' ``scratch``).
-SCRATCH = 13 * ROW
+#: Length of the scratch (:func:`camera_rays`' ``scratch``): one ROW past the last row.
+SCRATCH = DZ + ROW
 
 
 @njit(**_JIT)

@@ -59,11 +59,7 @@ class SceneData(NamedTuple):
     verts: np.ndarray  # (T, 3, 3) float64 copies of the float32 vertices Embree traces
     normals: np.ndarray  # (T, 3) unit normals of the triangles as traced
     areas: np.ndarray  # (T,)
-    material: np.ndarray  # (T,) int64 material of each triangle
     emission: np.ndarray  # (T, 3) radiance emitted (front side)
-    kinds: np.ndarray  # (M,) int64 BSDF kind of each material (pyoa.render.bsdf)
-    colors: np.ndarray  # (M, 3)
-    alphas: np.ndarray  # (M,) GGX roughness
     em: np.ndarray  # (E,) int64 emitting triangles (Emitters.index)
     em_cdf: np.ndarray  # (E,) their power CDF (Emitters.cdf)
     em_prob: np.ndarray  # (T,) probability of each triangle's choice (Emitters.prob)
@@ -205,8 +201,12 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, cl
     rays = 0
     t0 = _now(clock, ts)
     rr_key = np.empty(n, np.int64)
+    last, key = -1, 0
     for i in range(n):
-        rr_key[i] = hash_pair(np.int64(ps.seed), pixel[i], RR_KEY)
+        if pixel[i] != last:  # a pixel's samples are consecutive: one hash per pixel
+            last = pixel[i]
+            key = hash_pair(np.int64(ps.seed), last, RR_KEY)
+        rr_key[i] = key
     cam_scratch = np.empty(CAMERA_SCRATCH)
     spent[0] += _now(clock, ts) - t0
     for start in range(0, n, size):
@@ -283,16 +283,12 @@ class CompiledIntegrator:
         self._rtc = embree.Scene(scene.triangles, robust=getattr(scene, "robust_tracing", True))
         hit, occ = embree.query_addresses(self.packet)
         self._tracer = Tracer(self._rtc.handle, hit, occ, self.packet)
-        m, em = scene.materials, Emitters(scene)
+        em = Emitters(scene)
         c = np.ascontiguousarray
-        verts, kinds, material = c(scene.triangles, dtype=np.float64), c(m.kind, dtype=np.int64), c(scene.material,
-                                                                                               dtype=np.int64)
         self._scene = SceneData(
-            verts=verts, normals=c(scene.normals), areas=c(scene.areas), material=material,
-            emission=c(scene.emission), kinds=kinds, colors=c(m.color), alphas=c(m.alpha),
-            em=c(em.index, dtype=np.int64), em_cdf=c(em.cdf), em_prob=c(em.prob), reach=c(reach), growth=c(growth),
-            hit_data=hit_data(verts, scene.normals, scene.emission, em.prob, scene.areas, reach, material, kinds,
-                              m.alpha, m.color))
+            verts=c(scene.triangles, dtype=np.float64), normals=c(scene.normals), areas=c(scene.areas),
+            emission=c(scene.emission), em=c(em.index, dtype=np.int64), em_cdf=c(em.cdf), em_prob=c(em.prob),
+            reach=c(reach), growth=c(growth), hit_data=hit_data(scene, em.prob, reach))
         cam = PerspectiveCamera(scene.camera, width, height)
         self._camera = CameraData(width, height, cam.tan_x, cam.tan_y, c(cam.rot), c(cam.pos), cam.aperture,
                                   cam.focus_distance, c(cam.motion))

@@ -76,25 +76,27 @@ ROW = CHUNK + 8
  # the BSDF sample (local direction, weight, pdf, delta) and the new ray
  NIX, NIY, NIZ, WR, WG, WB, PDF, DELTA, ALIVE, NBR, NBG, NBB, NOX, NOY, NOZ, NDX, NDY, NDZ) = (
     k * ROW for k in range(105))
-#: Length of the scratch array.
-SCRATCH = 105 * ROW
+#: Length of the scratch array: one ROW past the last row.
+SCRATCH = NDZ + ROW
 #: The per-triangle values :func:`gather` copies, in the order of the rows
 #: ``V0X .. CB`` (:func:`hit_data` makes them).
 HIT_FIELDS = 16
 
 
-def hit_data(verts, normals, emission, em_prob, areas, reach, material, kinds, alphas, colors):
+def hit_data(scene, em_prob, reach):
     """What the shading reads of the triangle a ray hit, one contiguous row
-    of :data:`HIT_FIELDS` float64 per triangle (two cache lines instead of
-    one from each of eight arrays): its first vertex, unit normal, emitted
-    radiance, the pdf per unit area of choosing a point on it
+    of :data:`HIT_FIELDS` float64 per triangle of ``scene`` (two cache
+    lines instead of one from each of eight arrays): its first vertex, unit
+    normal, emitted radiance, the pdf per unit area of choosing a point on it
     (``em_prob / area``, the reference's first operation on the two, so the
-    same bits), its offset scale (``reach``), and its material's kind,
-    roughness and colour."""
-    mat = np.asarray(material)
+    same bits; ``em_prob``: :attr:`pyoa.render.emitters.Emitters.prob`), its
+    offset scale (``reach``: :func:`pyoa.render.integrator.triangle_reach`),
+    and its material's kind, roughness and colour."""
+    mat, m = np.asarray(scene.material), scene.materials
     return np.ascontiguousarray(np.column_stack([
-        np.asarray(verts, np.float64)[:, 0], normals, emission, np.asarray(em_prob) / np.asarray(areas), reach,
-        np.asarray(kinds, np.float64)[mat], np.asarray(alphas)[mat], np.asarray(colors)[mat]]), dtype=np.float64)
+        np.asarray(scene.triangles, np.float64)[:, 0], scene.normals, scene.emission,
+        np.asarray(em_prob) / np.asarray(scene.areas), reach, np.asarray(m.kind, np.float64)[mat],
+        np.asarray(m.alpha)[mat], np.asarray(m.color)[mat]]), dtype=np.float64)
 
 
 @njit(**_INLINE)
@@ -129,6 +131,7 @@ def emission_weight(depth, mis, pdf_light, prev_pdf, prev_delta):
         return 1.0
     if not mis:
         return 1.0 if prev_delta else 0.0  # without MIS only light sampling counts
+    # computed for every lane and then selected, so that a loop over lanes has no branch on prev_delta
     h = power_heuristic(prev_pdf, pdf_light)
     return 1.0 if prev_delta else h
 
