@@ -31,6 +31,7 @@ import ctypes
 import functools
 import glob
 import os
+import threading
 
 import numpy as np
 from llvmlite import ir
@@ -123,6 +124,33 @@ def query_addresses(width: int) -> tuple[int, int]:
             ctypes.cast(getattr(lib, f"rtcOccluded{width}"), ctypes.c_void_p).value)
 
 
+_device_lock = threading.Lock()
+_device = None
+
+
+def device() -> int:
+    """The process's Embree device (an ``RTCDevice`` handle), made on first use
+    with ``threads=1`` and kept until the process ends.
+
+    One device serves every :class:`Scene`, because a device per scene made
+    a render after the first one cost a core: releasing a device while
+    another lives makes Embree reconfigure TBB's ``global_control``, after
+    which one TBB worker thread spun in ``sched_yield`` for as long as the
+    next render ran (measured on Intel Xeon 6/207: a one-thread render used
+    1.9 cores of CPU time, a two-thread one ran 1.1-1.3x slower;
+    ``tests/render/test_embree.py`` checks that a render leaves no core
+    busy)."""
+    global _device
+    with _device_lock:
+        if _device is None:
+            lib = library()
+            dev = lib.rtcNewDevice(b"threads=1")
+            if not dev:
+                raise EmbreeUnavailable(f"rtcNewDevice failed (Embree error {lib.rtcGetDeviceError(None)})")
+            _device = dev
+        return _device
+
+
 class Scene:
     """A triangle scene built with Embree's own calls (one geometry, static).
 
@@ -145,9 +173,10 @@ class Scene:
     same triangles give the same BVH, and every ray the same hit, in every
     process (a multi-threaded build may split differently from run to run,
     and without robust mode a ray through a shared edge may then hit the
-    other triangle). ``handle`` is the ``RTCScene`` as an integer, for the
-    compiled queries. The scene keeps its device and buffers alive until
-    :meth:`close` (or garbage collection).
+    other triangle). Every scene lives on the one device of the process
+    (:func:`device`). ``handle`` is the ``RTCScene`` as an integer, for the
+    compiled queries. The scene keeps its buffers alive until :meth:`close`
+    (or garbage collection).
     """
 
     def __init__(self, triangles, *, robust: bool = True):
@@ -156,9 +185,7 @@ class Scene:
         if len(tris) == 0:
             raise ValueError("an Embree scene needs at least one triangle")
         self._lib = lib
-        self._device = lib.rtcNewDevice(b"threads=1")
-        if not self._device:
-            raise EmbreeUnavailable(f"rtcNewDevice failed (Embree error {lib.rtcGetDeviceError(None)})")
+        self._device = device()
         try:
             self._scene = lib.rtcNewScene(self._device)
             lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST if robust else 0)
@@ -189,13 +216,10 @@ class Scene:
         self.robust = bool(robust)
 
     def close(self) -> None:
-        """Release the scene and its device (idempotent)."""
+        """Release the scene (idempotent); the process's device stays."""
         if getattr(self, "_scene", None):
             self._lib.rtcReleaseScene(self._scene)
             self._scene = None
-        if getattr(self, "_device", None):
-            self._lib.rtcReleaseDevice(self._device)
-            self._device = None
 
     def __del__(self):
         try:

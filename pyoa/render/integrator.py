@@ -30,6 +30,7 @@ References
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -230,6 +231,19 @@ class Stats:
         self.rays += other.rays
 
 
+@functools.lru_cache(maxsize=1)
+def _embreex_device():
+    """The process's ``embreex`` device, on which every reference integrator
+    builds its scene: made once and kept. ``embreex`` would otherwise make
+    and release a device per scene, and releasing an Embree device while
+    another lives left a TBB worker spinning through the next compiled
+    render (see :func:`pyoa.render.embree.device`, which keeps the compiled
+    path's device for the same reason)."""
+    from embreex import rtcore
+
+    return rtcore.EmbreeDevice()
+
+
 class Integrator:
     """Path tracer for one scene and layout.
 
@@ -267,7 +281,7 @@ class Integrator:
         from embreex import rtcore_scene as rtcs
         from embreex.mesh_construction import TriangleMesh
 
-        tracer = rtcs.EmbreeScene()
+        tracer = rtcs.EmbreeScene(_embreex_device())
         TriangleMesh(tracer, np.ascontiguousarray(scene.triangles, dtype=np.float32))
         return tracer
 
