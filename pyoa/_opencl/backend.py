@@ -34,10 +34,14 @@ MAX_AXIS_GROUP = 1024
 PATHS = ("auto", "vector", "tables", "direct")
 #: Environment variable overriding the ``auto`` choice (one of :data:`PATHS`).
 ENV_PATH = "PYOA_OPENCL_PATH"
-#: Smallest request (pixels x samples x dims) for which ``auto`` builds a
-#: vector program: a new shape costs about a second to build once per process
-#: (docs/performance.md, "First use of a shape"); below 2^20 values the
-#: vector path saves under 2 ms a call.
+#: Values of one shape (pixels x samples x dims, summed over this process's
+#: requests of that shape) from which ``auto`` builds its vector program: a
+#: new shape costs about a second to build once per process
+#: (docs/performance.md, "First use of a shape"), and the vector path saves
+#: about 2 ms per 2^20 values. Summed, not per request, because a render asks
+#: for one batch of pixels after another (2^16 paths each, under 2^20 values
+#: below 16 dimensions), and there the table path cost 1.3-2x the vector
+#: path's time (Bose, 121 spp, 541 pixels a call, Intel Xeon 6/207).
 VECTOR_MIN_VALUES = 1 << 20
 
 
@@ -87,6 +91,9 @@ class OpenCLBackend:
         #: Whether the path was asked for (then the vector path takes requests
         #: of any size) rather than chosen by ``auto``.
         self.path_forced = path != "auto"
+        #: Values requested so far of each vector shape not yet built (see
+        #: :data:`VECTOR_MIN_VALUES`).
+        self._shape_values: dict = {}
         self._axis_limit = min(
             [MAX_AXIS_GROUP]
             + [self._kernels[k].get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.info.device)
@@ -199,21 +206,20 @@ class OpenCLBackend:
                          np.uint32(prm.block_dims), np.uint32(prm.s * prm.M), np.uint32(prm.M),
                          np.uint32(catalogue_types.OFFSET_CODES[req.offset]), np.float32(req.jitter),
                          *self._field(req.construction.field_order(prm)), self._constants(req))
-            use_vector = self.path == "vector" and (
-                self.path_forced or req.n_rows * req.n_dims >= VECTOR_MIN_VALUES)
+            use_vector = self.path == "vector"
             for rect in req.rectangles(row0, row1):
                 # each rectangle's values are a contiguous part of the chunk
                 at = np.uint32((rect.row0 - row0) * req.n_dims)
                 if req.construction.family != "oa":
                     bshp = vector.baseline_shape(req, rect) if use_vector else None
-                    if bshp is not None:
+                    if bshp is not None and self._vector_pays(bshp, rect, req.n_dims):
                         self._launch_vector_baseline(req, rect, bshp, buf, at, dims)
                         continue
                 else:
                     shp = vector.shape(req, rect) if use_vector else None
                     if shp is not None and not self.path_forced and not shp.tabled and req.tables_pay_off(rect):
                         shp = None  # a walked permutation: the table path is faster ('cmj', 'centered')
-                    if shp is not None:
+                    if shp is not None and self._vector_pays(shp, rect, req.n_dims):
                         self._launch_vector(req, rect, shp, buf, at, dims)
                         continue
                     if self.path != "direct" and req.tables_pay_off(rect) and req.array_cells_fit:
@@ -232,6 +238,21 @@ class OpenCLBackend:
             else:
                 cl.enqueue_copy(self.queue, out, buf)
             self.queue.finish()
+
+    def _vector_pays(self, shp, rect: Rect, n_dims: int) -> bool:
+        """Whether ``rect`` takes the vector program of ``shp``: always when
+        the path was forced, else once this process has asked for
+        :data:`VECTOR_MIN_VALUES` values of that shape (this rectangle's
+        included), so that a small request alone does not pay a build.
+        Called with self._lock held."""
+        if self.path_forced or vector.built(self.context, shp):
+            return True
+        total = self._shape_values.get(shp, 0) + rect.n_pixels * rect.n_k * n_dims
+        if total >= VECTOR_MIN_VALUES:
+            self._shape_values.pop(shp, None)
+            return True
+        self._shape_values[shp] = total
+        return False
 
     def _launch_1d(self, kernel, n: int, *args) -> None:
         """Launch 1D ``kernel`` over exactly ``n`` work-items: groups of

@@ -218,6 +218,12 @@ _lock = threading.Lock()
 _programs: dict[tuple, tuple] = {}
 
 
+def built(context, shp: Shape | BaselineShape) -> bool:
+    """Whether :func:`kernels` has built ``shp`` in ``context`` already."""
+    with _lock:
+        return (context.int_ptr, shp) in _programs
+
+
 def kernels(context, info, shp: Shape | BaselineShape) -> tuple:
     """``(vector_tables, vector_values)`` built for ``shp`` in ``context``,
     once per process; ``(vector_baseline,)`` for a :class:`BaselineShape`.

@@ -436,9 +436,10 @@ def test_padded_2d_vector_shape_limits():
 
 
 def test_auto_takes_the_vector_path_only_for_large_requests(monkeypatch, opencl, opencl_device):
-    """``auto`` on a CPU builds a vector program only for requests of at least
-    VECTOR_MIN_VALUES values (a build costs about a second once); a forced
-    ``vector`` takes any size. Both give NumPy's bits."""
+    """``auto`` on a CPU builds a vector program only once VECTOR_MIN_VALUES
+    values of its shape were asked for (a build costs about a second once),
+    in one request or summed over several (a render's batches); a forced
+    ``vector`` takes any size. All give NumPy's bits."""
     from pyoa._opencl import backend as backend_mod
     from pyoa._opencl.backend import OpenCLBackend
 
@@ -453,9 +454,23 @@ def test_auto_takes_the_vector_path_only_for_large_requests(monkeypatch, opencl,
         launched = spy(monkeypatch, be)
         req = compare(be, smp, pixels, None, None, f"small request, path_forced={be.path_forced}")
         assert bool(launched["vector"]) is takes
-    monkeypatch.setattr(backend_mod, "VECTOR_MIN_VALUES", len(pixels) * 121 * 10)
+    # no shape built yet in this process (earlier tests share the context):
+    # the third request of a shape reaches the threshold, and it and every
+    # later one take the vector path
+    from pyoa._opencl import vector
+
+    monkeypatch.setattr(vector, "_programs", {})
+    monkeypatch.setattr(backend_mod, "VECTOR_MIN_VALUES", 3 * len(pixels) * 121 * 9)
+    smp9 = make("bose", 121, 9, seed=9, backend="numpy")
+    for i, takes in enumerate((False, False, True, True)):
+        launched = spy(monkeypatch, auto)
+        req = compare(auto, smp9, [p + 7 * i for p in pixels], None, None, f"request {i} of the same shape")
+        assert launched["vector"] == (req.rectangles(0, req.n_rows) if takes else []), i
+    # one request at the threshold takes it at once
+    monkeypatch.setattr(backend_mod, "VECTOR_MIN_VALUES", len(pixels) * 121 * 8)
+    smp8 = make("bose", 121, 8, seed=9, backend="numpy")
     launched = spy(monkeypatch, auto)
-    req = compare(auto, smp, pixels, None, None, "request at the threshold")
+    req = compare(auto, smp8, pixels, None, None, "request at the threshold")
     assert launched["vector"] == req.rectangles(0, req.n_rows)
 
 
