@@ -137,7 +137,7 @@ def device() -> int:
     another lives makes Embree reconfigure TBB's ``global_control``, after
     which one TBB worker thread spun in ``sched_yield`` for as long as the
     next render ran (measured on Intel Xeon 6/207: a one-thread render used
-    1.9 cores of CPU time, a two-thread one ran 1.1-1.3x slower;
+    1.9 cores of CPU time, a two-thread one ran about 1.2x slower;
     ``tests/render/test_embree.py`` checks that a render leaves no core
     busy)."""
     global _device
