@@ -141,7 +141,7 @@ def device() -> int:
     ``tests/render/test_embree.py`` checks that a render leaves no core
     busy)."""
     global _device
-    with _device_lock:
+    with _device_lock:  # render threads may build their first scenes at once: one device, never two
         if _device is None:
             lib = library()
             dev = lib.rtcNewDevice(b"threads=1")
@@ -185,15 +185,15 @@ class Scene:
         if len(tris) == 0:
             raise ValueError("an Embree scene needs at least one triangle")
         self._lib = lib
-        self._device = device()
+        dev = device()
         try:
-            self._scene = lib.rtcNewScene(self._device)
+            self._scene = lib.rtcNewScene(dev)
             lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST if robust else 0)
-            geom = lib.rtcNewGeometry(self._device, _GEOMETRY_TYPE_TRIANGLE)
+            geom = lib.rtcNewGeometry(dev, _GEOMETRY_TYPE_TRIANGLE)
             vb = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3, 12, 3 * len(tris))
             ib = lib.rtcSetNewGeometryBuffer(geom, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3, 12, len(tris))
             if not vb or not ib:
-                err = lib.rtcGetDeviceError(self._device)
+                err = lib.rtcGetDeviceError(dev)
                 kind = MemoryError if err == _ERROR_OUT_OF_MEMORY else EmbreeUnavailable
                 raise kind(f"Embree could not allocate the buffers of {len(tris)} triangles (error {err})")
             # Embree owns these buffers (and pads the vertex buffer as it needs).
@@ -204,7 +204,7 @@ class Scene:
             lib.rtcAttachGeometry(self._scene, geom)
             lib.rtcReleaseGeometry(geom)
             lib.rtcCommitScene(self._scene)
-            err = lib.rtcGetDeviceError(self._device)
+            err = lib.rtcGetDeviceError(dev)
             if err:
                 kind = MemoryError if err == _ERROR_OUT_OF_MEMORY else EmbreeUnavailable
                 raise kind(f"Embree could not build the scene of {len(tris)} triangles (error {err})")
