@@ -10,7 +10,9 @@ The small numerical pieces that a study of estimators needs, shared by
 * :func:`pass_variance`: the per-pixel variance of a mean of independent
   render passes, from their running sum and sum of squares [2]_;
 * :func:`ratio_ci`: the ratio of two means (one sampler's error over
-  another's) with a delta-method interval [5]_;
+  another's) with an interval that holds at 2 to 8 seeds (delta method on
+  the log ratio [5]_, Student's t at Welch-Satterthwaite degrees of
+  freedom [6]_, [7]_);
 * :func:`relmse_noise` and :func:`corrected`: how much a reference image's
   own noise adds to a relative MSE [3]_, [4]_ measured against it, and the
   measurement with that part taken out.
@@ -30,6 +32,11 @@ References
    Forum 38(4) (EGSR 2019).
 .. [5] G. Casella, R. L. Berger, *Statistical Inference*, 2nd ed., Duxbury,
    2002, section 5.5.4 (the delta method).
+.. [6] F. E. Satterthwaite, "An approximate distribution of estimates of
+   variance components", Biometrics Bulletin 2(6) (1946), 110-114.
+.. [7] B. L. Welch, "The generalization of 'Student's' problem when several
+   different population variances are involved", Biometrika 34 (1947),
+   28-35.
 
 Examples
 --------
@@ -152,36 +159,71 @@ def mean_ci(values, level: float = 0.95) -> tuple[float, float, float]:
 
 
 def ratio_ci(a, b, *, shift_a: float = 0.0, shift_b: float = 0.0, level: float = 0.95) -> tuple[float, float, float]:
-    """Ratio of two means with a delta-method confidence interval.
+    """Ratio of two means with a confidence interval that holds at few values.
 
     With :math:`\\bar a, \\bar b` the means of the finite entries of ``a``
     and ``b`` less ``shift_a`` and ``shift_b`` (constants known in advance,
-    such as a reference's noise, :func:`corrected`), and :math:`s_a, s_b`
-    their sample standard deviations over :math:`n_a, n_b` independent
-    values, the ratio :math:`r = \\bar a / \\bar b` has approximate
-    standard error
+    such as a reference's noise, :func:`corrected`), :math:`s_a, s_b` their
+    sample standard deviations over :math:`n_a, n_b` independent values, and
+    :math:`r = \\bar a / \\bar b`, the interval is built on the log of the
+    ratio, whose delta-method [5]_ variance is the sum of the two squared
+    relative standard errors,
 
     .. math::
 
-        \\operatorname{se}(r) \\approx |r| \\sqrt{\\frac{s_a^2}{n_a \\bar a^2} + \\frac{s_b^2}{n_b \\bar b^2}}
+        u_a = \\frac{s_a^2}{n_a \\bar a^2}, \\quad u_b = \\frac{s_b^2}{n_b \\bar b^2},
+        \\qquad \\operatorname{Var}(\\log r) \\approx u_a + u_b,
 
-    (first-order Taylor expansion of :math:`a/b`, the delta method [5]_),
-    and the interval is :math:`r \\pm z_{(1+\\gamma)/2} \\operatorname{se}(r)`.
-    It is approximate: good when both relative standard errors are small
-    (a few seeds of errors that vary by tens of percent), poor when a mean is
-    near zero.
+    with Student's t at the Welch-Satterthwaite degrees of freedom [6]_, [7]_
+    of that sum in place of the normal quantile:
+
+    .. math::
+
+        \\nu = \\frac{(u_a + u_b)^2}{u_a^2/(n_a - 1) + u_b^2/(n_b - 1)}, \\qquad
+        r\\,\\exp\\left(\\pm\\, t_{(1+\\gamma)/2,\\,\\nu} \\sqrt{u_a + u_b}\\right).
+
+    Why not the plain delta method, :math:`r \\pm z\\,\\operatorname{se}(r)`:
+    its 95 % interval covered the true ratio in 76-82 % of the synthetic
+    studies below with 2 seeds a side, 86-90 % with 4 and 91-94 % with 8,
+    because :math:`z = 1.96` ignores that each spread is estimated from
+    few values (with 2 a side, one degree of freedom each: t = 12.7). On the
+    log scale the interval stays positive, as a ratio of errors is, and it
+    widens towards large ratios as the ratio's skewed distribution does.
+    Coverage, by simulation (``tests/test_statistics.py``: normal and gamma
+    values with known means and per-value spreads of 5 % to 50 %, 2, 4 and 8
+    values a side): between 93 % and 98 % for a 95 % interval; with 2 values
+    a side it is conservative (about 96-98 %) and wide.
+
+    Parameters
+    ----------
+    a, b : array_like of real, 1-D
+        Independent measurements of the numerator and the denominator (e.g.
+        one relMSE per seed of two samplers).
+    shift_a, shift_b : float
+        Subtracted from the means (not from the spreads).
+    level : float
+        Confidence level, in the open interval (0, 1).
 
     Returns
     -------
     ratio, low, high : float
         NaN when a mean is not positive; ``low``/``high`` NaN when either
-        side has fewer than two values.
+        side has fewer than two values; ``low == high == ratio`` when
+        neither side varies; ``high`` may be infinite when a mean is
+        indistinguishable from 0.
+
+    Raises
+    ------
+    ValueError
+        ``level`` not a number in (0, 1).
+    TypeError
+        ``a`` or ``b`` not a 1-D array-like of real numbers.
 
     Examples
     --------
     >>> r, lo, hi = ratio_ci([1.0, 1.2, 0.8, 1.0], [2.0, 2.2, 1.8, 2.0])
     >>> round(r, 3), round(lo, 3), round(hi, 3)
-    (0.5, 0.411, 0.589)
+    (0.5, 0.392, 0.638)
     """
     if (isinstance(level, (bool, np.bool_)) or not isinstance(level, numbers.Real)
             or not 0.0 < float(level) < 1.0):
@@ -196,11 +238,16 @@ def ratio_ci(a, b, *, shift_a: float = 0.0, shift_b: float = 0.0, level: float =
     r = ma / mb
     if len(xa) < 2 or len(xb) < 2:
         return r, math.nan, math.nan
-    from scipy.stats import norm
+    ua = float(xa.var(ddof=1)) / (len(xa) * ma * ma)
+    ub = float(xb.var(ddof=1)) / (len(xb) * mb * mb)
+    if ua + ub == 0.0:
+        return r, r, r
+    from scipy.stats import t
 
-    se = abs(r) * math.sqrt(xa.var(ddof=1) / (len(xa) * ma * ma) + xb.var(ddof=1) / (len(xb) * mb * mb))
-    z = float(norm.ppf(0.5 + 0.5 * float(level)))
-    return r, r - z * se, r + z * se
+    nu = (ua + ub) ** 2 / (ua * ua / (len(xa) - 1) + ub * ub / (len(xb) - 1))
+    half = float(t.ppf(0.5 + 0.5 * float(level), nu)) * math.sqrt(ua + ub)
+    # a mean near zero makes the interval unbounded above, not an OverflowError
+    return r, r * math.exp(-half), (r * math.exp(half) if half < 700.0 else math.inf)
 
 
 def fit_loglog(n, v) -> tuple[float, float]:
