@@ -28,7 +28,8 @@ The report (``DIR/study.md``, :func:`report`):
 * the slope of log error against log spp per sampler
   (:func:`~pyoa.analysis.statistics.fit_loglog`), and a headline: bose
   against the best padded 2D sampler and against sobol, as ratios of means
-  with intervals (:func:`~pyoa.analysis.statistics.ratio_ci`).
+  with intervals that hold their level at 2 to 8 seeds
+  (:func:`~pyoa.analysis.statistics.ratio_ci`).
 
 Figures: ``DIR/study.png`` (every scene) and ``DIR/study-SCENE.png``, error
 against spp on log-log axes with the intervals as bands, like the paper's
@@ -60,9 +61,10 @@ from pathlib import Path
 import numpy as np
 
 from . import catalogue
-from .analysis.statistics import corrected, fit_loglog, mean_ci, ratio_ci, relmse_noise
+from .analysis.statistics import corrected, fit_loglog, mean_ci, ratio_ci
 from .atomic import atomic_path, check_writable
-from .catalogue_types import MAX_SPP, MAX_UINT32, check_int
+from .catalogue_types import MAX_SPP, check_int
+from .units import format_interval, format_ratio
 
 #: Samplers of a study by default: the paper's table (random, the padded 2D
 #: samplers, bose, and the high-dimensional halton and sobol).
@@ -74,8 +76,6 @@ PADDED = ("jittered2d", "cmj2d", "sobol02", "zsobol", "pmj02")
 FIELDS = ("scene", "sampler", "spp_asked", "spp", "seed", "relmse", "relmse_crop", "mse", "seconds")
 #: Version of study.json (a study of another version is not resumed).
 STUDY_VERSION = 1
-#: Most seeds per (scene, sampler, spp): a typo guard.
-MAX_SEEDS = 1 << 16
 #: The lock file of a study's directory (:func:`lock_study`).
 LOCK_NAME = ".lock"
 #: Prefix of a reference's identity in study.json (:func:`pixel_identity`). A
@@ -580,17 +580,8 @@ def slope(by_spp: dict, crop: bool = False) -> float:
     return fit_loglog(n, v)[0]
 
 
-def _fmt(m: float, lo: float, hi: float) -> str:
-    if not math.isfinite(lo):
-        return f"{m:.3g}"
-    return f"{m:.3g} ± {(hi - lo) / 2:.2g}"
-
-
 def _ratio(a: Cell, b: Cell) -> str:
-    r, lo, hi = ratio_ci(a.values, b.values, shift_a=a.noise, shift_b=b.noise)
-    if not math.isfinite(r):
-        return "n/a"
-    return f"{r:.2f} [{lo:.2f}, {hi:.2f}]" if math.isfinite(lo) else f"{r:.2f}"
+    return format_ratio(*ratio_ci(a.values, b.values, shift_a=a.noise, shift_b=b.noise))
 
 
 def headline(table: dict) -> list[str]:
@@ -652,7 +643,7 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
                         cols.append("-")
                         continue
                     note = f" ({c.spp})" if c.spp != a else ""
-                    cols.append(_fmt(*c.ci(crop)) + note)
+                    cols.append(format_interval(*c.ci(crop)) + note)
                 sl = slope(by, crop)
                 lines.append(f"| {n} | " + " | ".join(cols) + f" | {sl:.2f} |" if math.isfinite(sl) else
                              f"| {n} | " + " | ".join(cols) + " | - |")
@@ -664,7 +655,9 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
     if head:
         lines += ["## Headline", "",
                   "Ratios of noise-corrected mean image relMSE (below 1: bose is better), with 95 % intervals "
-                  "(delta method over seeds); the best padded sampler is the one of " + ", ".join(PADDED) +
+                  "over seeds (delta method on the log ratio with Student's t at Welch-Satterthwaite degrees of "
+                  "freedom, which holds its level with 2 to 8 seeds; see pyoa.analysis.ratio_ci); the best "
+                  "padded sampler is the one of " + ", ".join(PADDED) +
                   " with the lowest mean at that count.", "", *head, ""]
     return "\n".join(lines)
 
@@ -718,24 +711,6 @@ def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
 
 
 # -- the command ---------------------------------------------------------------------------------
-
-
-def _reference_noise(ref_path: Path, ref: np.ndarray, crop) -> tuple[float, float] | None:
-    """(image, crop) noise estimates of a reference from its variance file, or None without one. A
-    variance path that is not a regular file is refused (reading a FIFO hangs), not taken for none."""
-    from .render.image import read_image
-    from .render.reference import variance_path
-    from .render.state import check_state_file
-
-    vp = variance_path(ref_path)
-    check_state_file(vp, "the variance of a study's reference", "remove or rename it")
-    if not vp.exists():
-        return None
-    var = read_image(vp)[..., :3].astype(np.float64)
-    if var.shape != ref.shape:
-        raise ValueError(f"{vp} is {var.shape[1]} x {var.shape[0]}, its reference {ref.shape[1]} x "
-                         f"{ref.shape[0]}: not this reference's variance; remove it")
-    return relmse_noise(var, ref), relmse_noise(var, ref, crop)
 
 
 @dataclass
@@ -864,10 +839,10 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
 def run(args) -> int:
     """``pyoa study`` (see the module docstring and ``pyoa study --help``)."""
     from .cluster import check_engine, engine, progress_over
-    from .render.commands import _check_job_memory, _default_crop
+    from .render.commands import _check_job_memory, _default_crop, check_seeds
     from .render.image import check_crop, read_reference
     from .render.integrator import RENDERER_VERSION
-    from .render.reference import render_reference
+    from .render.reference import reference_noise, render_reference
     from .render.render import plan, resolve_shading
     from .render.scene import load
     from .render.scene_source import source_of
@@ -877,8 +852,8 @@ def run(args) -> int:
     scenes_arg = list(dict.fromkeys(args.scenes))
     names = sampler_names(args.samplers)
     spp_list = parse_spp(args.spp)
-    seeds = check_int("--seeds", args.seeds, 1, MAX_SEEDS)
-    seed0 = check_int("--seed", args.seed, 0, MAX_UINT32 - seeds + 1, " (the first of --seeds uint32 seeds)")
+    seed_list = check_seeds(args.seed, args.seeds)
+    seeds, seed0 = len(seed_list), seed_list[0]
     if args.max_depth is not None:
         from .render.layout import MAX_DEPTH
 
@@ -943,7 +918,7 @@ def run(args) -> int:
                                  "them; give another --out")
         refs = plan_references(args, out, loaded, settings, rows, dims, planned, shading, pass_spp)
         # the variance files of the references at hand (a given one's too)
-        noise = {n: _reference_noise(r.path, r.pixels, crop) for n, r in refs.items() if r.pixels is not None}
+        noise = {n: reference_noise(r.path, r.pixels, crop) for n, r in refs.items() if r.pixels is not None}
         # every check made: now the rows the run appends to, as the catalogue spells them, once each
         rows = read_rows(out / "study.csv", repair=True)
         with engine(args.workers, args.scheduler) as eng:
@@ -964,7 +939,7 @@ def run(args) -> int:
                         # the settings of its rows' reference, rendered again with other pixels (another pyoa)
                         raise ValueError(f"{out} holds {name} renders measured against another reference; give "
                                          "another --out (or the reference they used)")
-                    noise[name] = _reference_noise(ref.path, ref.pixels, crop)
+                    noise[name] = reference_noise(ref.path, ref.pixels, crop)
                 identity = pixel_identity(ref.pixels)
                 if ref.made_with is not None:
                     rec.update(ref.made_with)

@@ -29,6 +29,7 @@ import pytest
 from pyoa import study
 from pyoa.cli import main
 from pyoa.render.image import read_image
+from pyoa.render.reference import reference_noise
 from pyoa.render.scene import bundled
 
 from .test_hardening_cli import _limit_memory, assert_refused, pyoa
@@ -378,8 +379,8 @@ def test_a_variance_file_that_is_not_a_regular_file_is_refused(d):
     variance = d / "reference-dof7d.variance.exr"
     variance.unlink()
     os.mkfifo(variance)
-    with pytest.raises(ValueError, match=f"^{str(variance)!r} \\(the variance of a study's reference\\) is a FIFO"):
-        study._reference_noise(ref, read_image(ref)[..., :3], (2, 2, 4, 4))
+    with pytest.raises(ValueError, match=f"^{str(variance)!r} \\(the variance of a reference\\) is a FIFO"):
+        reference_noise(ref, read_image(ref)[..., :3], (2, 2, 4, 4))
 
 
 # -- review: a reference known by its file's bytes -------------------------------------------------

@@ -8,12 +8,12 @@ import math
 from pathlib import Path
 
 from .. import catalogue
-from ..analysis.statistics import relmse_noise
+from ..analysis.statistics import corrected, mean_ci, ratio_ci, relmse_noise
 from ..atomic import atomic_path
 from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
 from ..cluster import add_arguments as add_engine_arguments
 from ..cluster import check_engine, engine
-from ..units import format_rate
+from ..units import format_interval, format_rate, format_ratio
 from .image import (
     EXR,
     PNG,
@@ -28,7 +28,7 @@ from .image import (
 )
 from .layout import MAX_DEPTH
 from .progressive import check_progressive, render_progressive, state_path
-from .reference import reference_key, render_reference, variance_path
+from .reference import reference_key, reference_noise, render_reference, variance_path
 from .render import SHADINGS, check_memory, plan, resolve_shading
 from .scene import load
 from .state import check_state_file
@@ -39,6 +39,8 @@ from .tiles import render_on
 #: relMSE (``pyoa render``, ``pyoa compare``), the float64 running sum, its
 #: pass and the mean (``pyoa reference``).
 POST_PIXEL_BYTES = 256
+#: Most seeds per sampler of ``pyoa compare --seeds`` and ``pyoa study --seeds``: a typo guard.
+MAX_SEEDS = 1 << 16
 #: Most passes of ``pyoa reference``: pass seeds hash a uint32 pass index.
 MAX_PASSES = MAX_UINT32 + 1
 
@@ -95,11 +97,13 @@ def cmd_render(args) -> int:
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.spp, base=args.base)
     _check_job_memory(p, f"pyoa render of {p.width} x {p.height} at {p.sampler.spp} spp")
-    ref = None
+    ref = noise = None
     if args.reference:
         ref = read_reference(args.reference, "--reference", p.width, p.height)
         if args.crop:
             check_crop(args.crop, p.width, p.height)
+        # read before the render: a bad variance file fails now, not after it
+        noise = reference_noise(args.reference, ref[..., :3].astype("float64"), args.crop or (0, 0, p.width, p.height))
     if args.progressive:
         pres = render_progressive(scene, out=args.out, png=args.png, sampler=args.sampler, spp=args.spp,
                                   seed=args.seed, base=args.base, **_size(args), max_depth=args.max_depth,
@@ -130,11 +134,26 @@ def cmd_render(args) -> int:
             print(f"{res.seconds:.2f} s{where}, {format_rate(res.paths_per_second)}paths/s, "
                   f"{format_rate(res.rays_per_second)}rays/s -> {args.out}{' and ' + args.png if args.png else ''}")
     if ref is not None:
-        line = f"relMSE {rel_mse(image, ref):.6g}"
-        if args.crop:
-            line += f", crop {rel_mse(image, ref, args.crop):.6g}"
-        print(line)
+        print(relmse_line(image, ref, args.crop, noise, args.reference))
     return 0
+
+
+def relmse_line(image, ref, crop, noise, reference) -> str:
+    """``pyoa render --reference``'s result: the relMSE (and the crop's), with the reference's own
+    noise subtracted where its variance file gives it, and said where it does not."""
+    line = f"relMSE {rel_mse(image, ref):.6g}"
+    if crop:
+        line += f", crop {rel_mse(image, ref, crop):.6g}"
+    var = variance_path(reference).name
+    if noise is None:
+        return line + f" (the reference's own noise is unknown: no {var} beside it, as `pyoa reference` writes)"
+    line += f"; less the reference's own noise (an estimated {noise[0]:.3g}"
+    if crop:
+        line += f", crop {noise[1]:.3g}"
+    line += f", from {var}): {corrected(rel_mse(image, ref), noise[0]):.6g}"
+    if crop:
+        line += f", crop {corrected(rel_mse(image, ref, crop), noise[1]):.6g}"
+    return line
 
 
 def _compare_outputs(out: str) -> list[Path]:
@@ -149,6 +168,14 @@ def _compare_outputs(out: str) -> list[Path]:
     return paths
 
 
+def check_seeds(seed, seeds) -> list[int]:
+    """The seeds of ``--seed S --seeds N``: S, S+1, ..., S+N-1, all uint32 (``pyoa compare`` and
+    ``pyoa study``)."""
+    n = check_int("--seeds", seeds, 1, MAX_SEEDS)
+    first = check_int("--seed", seed, 0, MAX_UINT32 - n + 1, " (the first of --seeds uint32 seeds)")
+    return list(range(first, first + n))
+
+
 def cmd_compare(args) -> int:
     names = [n.strip() for n in args.samplers.split(",") if n.strip()]
     if not names:
@@ -157,6 +184,7 @@ def cmd_compare(args) -> int:
     for n in names:
         catalogue.get(n)  # unknown names fail before any rendering
     _check_counts(args)
+    seeds = check_seeds(args.seed, args.seeds)
     md_path, csv_path, png_path = _compare_outputs(args.out)
     scene = load(args.scene)
     jobs = []
@@ -168,13 +196,16 @@ def cmd_compare(args) -> int:
     ref = read_reference(args.reference, "--reference", p.width, p.height)
     crop = args.crop or _default_crop(ref.shape)
     check_crop(crop, p.width, p.height)
+    noise = reference_noise(args.reference, ref[..., :3].astype("float64"), crop)
     check_engine(args.workers, args.scheduler)
     rows = []
     crops = []
     with engine(args.workers, args.scheduler) as eng:
         for name, spp in jobs:
-            rows.append(_compare_one(eng, scene, args, name, spp, ref, crop, crops))
-    md = markdown_table(scene.name, rows, crop)
+            for seed in seeds:
+                rows.append(_compare_one(eng, scene, args, name, spp, seed, ref, crop, crops))
+    md = markdown_table(scene.name, rows, crop, seeds=seeds, noise=noise, reference=args.reference,
+                        asked=args.spp)
     print(md)
     with atomic_path(md_path) as tmp:
         tmp.write_text(md)
@@ -191,19 +222,20 @@ def cmd_compare(args) -> int:
     return 0
 
 
-def _compare_one(eng, scene, args, name: str, spp: int, ref, crop, crops: list) -> dict:
-    """Render one sampler of ``pyoa compare`` on ``eng``: its row, its crop appended to ``crops``."""
-    res = render_on(eng, scene, sampler=name, spp=spp, seed=args.seed, **_size(args), max_depth=args.max_depth,
+def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, crops: list) -> dict:
+    """Render one sampler and seed of ``pyoa compare`` on ``eng``: its CSV row; the crop of each
+    sampler's first seed is appended to ``crops`` (the figure)."""
+    res = render_on(eng, scene, sampler=name, spp=spp, seed=seed, **_size(args), max_depth=args.max_depth,
                     filter=args.filter, first=args.first, backend=args.backend, shading=args.shading,
                     progress=not args.quiet)
-    check_finite(res.image, f"the {name} render ({spp} spp)")  # a NaN relMSE is no answer
-    row = dict(sampler=name, spp=spp, note="" if spp == args.spp else f"nearest valid to {args.spp}",
-               relmse=rel_mse(res.image, ref), relmse_crop=rel_mse(res.image, ref, crop),
-               seconds=round(res.seconds, 3))
-    x, y, w, h = crop
-    crops.append((name, spp, res.image[y:y + h, x:x + w]))
+    check_finite(res.image, f"the {name} render ({spp} spp, seed {seed})")  # a NaN relMSE is no answer
+    row = dict(sampler=name, spp_asked=args.spp, spp=spp, seed=seed, relmse=rel_mse(res.image, ref),
+               relmse_crop=rel_mse(res.image, ref, crop), seconds=round(res.seconds, 3))
+    if seed == args.seed:
+        x, y, w, h = crop
+        crops.append((name, spp, res.image[y:y + h, x:x + w]))
     if not args.quiet:
-        print(f"{name:12s} {spp:6d} spp  relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
+        print(f"{name:12s} {spp:6d} spp  seed {seed:<4d} relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
               f"({res.seconds:.1f} s)")
     return row
 
@@ -213,13 +245,53 @@ def _default_crop(shape):
     return (w // 4, h // 4, max(1, w // 4), max(1, h // 4))
 
 
-def markdown_table(scene: str, rows, crop) -> str:
+def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], noise, reference, asked: int) -> str:
+    """The report of ``pyoa compare``: per sampler, the mean relMSE over seeds less the reference's own
+    noise (:func:`~pyoa.render.reference.reference_noise`), with its 95 % Student-t interval
+    (:func:`~pyoa.analysis.statistics.mean_ci`) and its ratio to the first sampler's
+    (:func:`~pyoa.analysis.statistics.ratio_ci`), as ``pyoa study`` computes them."""
+    import numpy as np
+
     x, y, w, h = crop
-    lines = [f"| sampler | spp | relMSE (image) | relMSE (crop {w}x{h} at {x},{y}) | note |",
-             "|---|---:|---:|---:|---|"]
+    nz = noise or (0.0, 0.0)
+    by: dict = {}
     for r in rows:
-        lines.append(f"| {r['sampler']} | {r['spp']} | {r['relmse']:.5g} | {r['relmse_crop']:.5g} | {r['note']} |")
-    return f"Scene `{scene}`; relMSE = mean of (image - ref)^2 / (ref^2 + 0.01)\n\n" + "\n".join(lines) + "\n"
+        by.setdefault(r["sampler"], []).append(r)
+    first = next(iter(by))
+    base = np.array([r["relmse"] for r in by[first]])
+    seeds_say = (f"seed {seeds[0]}" if len(seeds) == 1 else
+                 f"{len(seeds)} seeds ({seeds[0]}..{seeds[-1]}) per sampler")
+    if noise is None:
+        ref_say = (f"its own noise is unknown (no {variance_path(reference).name} beside it; references made "
+                   "with `pyoa reference` have one), so the figures are not corrected")
+    else:
+        ref_say = (f"its own noise adds an estimated {nz[0]:.2g} to every image relMSE and {nz[1]:.2g} to every "
+                   f"crop relMSE (from the per-pixel variance in {variance_path(reference).name}); both are "
+                   "subtracted below")
+    cells = ("Each cell: the mean over seeds" + (" minus that noise" if noise is not None else "") +
+             ", ± the half-width of its 95 % Student-t interval" if len(seeds) > 1 else
+             "Each cell: one render's relMSE" + (" minus that noise" if noise is not None else "") +
+             " (one seed: no interval; give --seeds 2 or more for intervals)")
+    lines = [f"Scene `{scene}`, {seeds_say}; relMSE = mean of (image - ref)^2 / (ref^2 + 0.01).", "",
+             f"Reference `{Path(reference).name}`: {ref_say}.", "",
+             f"{cells}. The ratio is the image relMSE's to {first}'s" +
+             (" (below 1: less error), with its 95 % interval (delta method on the log ratio, Student's t)."
+              if len(seeds) > 1 else " (below 1: less error)."), "",
+             f"| sampler | spp | relMSE (image) | relMSE (crop {w}x{h} at {x},{y}) | / {first} | seconds |",
+             "|---|---:|---:|---:|---:|---:|"]
+    for name, rs in by.items():
+        spp = rs[0]["spp"]
+        spp_cell = f"{spp}" if spp == asked else f"{spp} ({asked} asked: nearest valid)"
+        image = np.array([r["relmse"] for r in rs])
+        crop_v = np.array([r["relmse_crop"] for r in rs])
+        cells_ = []
+        for v, n in ((image, nz[0]), (crop_v, nz[1])):
+            m, lo, hi = mean_ci(v)
+            cells_.append(format_interval(corrected(m, n), corrected(lo, n), corrected(hi, n)))
+        ratio = "1" if name == first else format_ratio(*ratio_ci(image, base, shift_a=nz[0], shift_b=nz[0]))
+        secs = sum(r["seconds"] for r in rs) / len(rs)
+        lines.append(f"| {name} | {spp_cell} | {cells_[0]} | {cells_[1]} | {ratio} | {secs:.2f} |")
+    return "\n".join(lines) + "\n"
 
 
 def crop_figure(path, crops, ref_crop) -> None:
@@ -346,6 +418,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--reference", required=True, help="reference EXR (pyoa reference SCENE)")
     p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
                    help="crop window (default: the quarter-size window at (W/4, H/4))")
+    p.add_argument("--seeds", type=int, default=1, metavar="N",
+                   help="render each sampler with seeds --seed .. --seed+N-1 and report means with 95 %% "
+                        "intervals (default 1: one render each, no interval)")
     p.add_argument("--out", default="compare", help="output stem: STEM.md, STEM.csv, STEM.png (default compare)")
     p.set_defaults(func=cmd_compare)
 

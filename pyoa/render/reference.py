@@ -62,6 +62,29 @@ def variance_path(out) -> Path:
     return out.with_name(out.name[: -len(out.suffix)] + ".variance.exr" if out.suffix else out.name + ".variance.exr")
 
 
+def reference_noise(path, reference: np.ndarray, crop) -> tuple[float, float] | None:
+    """How much the reference ``path``'s own noise adds to a relative MSE
+    measured against it, over the image and over ``crop``:
+    :func:`pyoa.analysis.statistics.relmse_noise` of the per-pixel variance
+    in its :func:`variance_path` file; None when it has none (a reference not
+    made by ``pyoa reference``, whose noise is unknown). ``reference`` holds
+    its pixels (H, W, 3). A variance path that is not a regular file is
+    refused (reading a FIFO hangs), not taken for none; one of another size
+    is refused as another reference's."""
+    from ..analysis.statistics import relmse_noise
+    from .image import read_image
+
+    vp = variance_path(path)
+    check_state_file(vp, "the variance of a reference", "remove or rename it")
+    if not vp.exists():
+        return None
+    var = read_image(vp)[..., :3].astype(np.float64)
+    if var.shape != reference.shape:
+        raise ValueError(f"{vp} is {var.shape[1]} x {var.shape[0]}, its reference {reference.shape[1]} x "
+                         f"{reference.shape[0]}: not this reference's variance; remove it")
+    return relmse_noise(var, reference), relmse_noise(var, reference, crop)
+
+
 def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int, filter: str, shading: str) -> dict:
     """Every setting that changes the bits of a reference pass (the backend
     and the engine do not: every backend gives the same samples, every engine

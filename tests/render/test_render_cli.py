@@ -72,7 +72,8 @@ def test_render_reference_prints_relmse(tmp_path, capsys):
     assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "-q",
                  "--reference", str(ref_path), "--crop", "4", "4", "8", "8"]) == 0
     line = capsys.readouterr().out.strip()
-    m = re.fullmatch(r"relMSE (\S+), crop (\S+)", line)
+    m = re.fullmatch(r"relMSE (\S+), crop (\S+) \(the reference's own noise is unknown: no ref.variance.exr "
+                     r"beside it, as `pyoa reference` writes\)", line)
     assert m, line
     img = read_image(out)
     assert float(m.group(1)) == pytest.approx(rel_mse(img, ref), rel=1e-5)
@@ -81,7 +82,28 @@ def test_render_reference_prints_relmse(tmp_path, capsys):
     # against itself: 0
     assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(tmp_path / "y.exr"), "-q",
                  "--reference", str(out)]) == 0
-    assert capsys.readouterr().out.strip() == "relMSE 0"
+    assert capsys.readouterr().out.strip().startswith("relMSE 0 (the reference's own noise is unknown")
+
+
+def test_render_reference_subtracts_the_reference_noise(tmp_path, capsys):
+    from pyoa.render.reference import reference_noise
+
+    ref_path, out = tmp_path / "ref.exr", tmp_path / "x.exr"
+    assert main(["reference", "cornell", "--size", "16", "16", "--spp", "64", "--pass-spp", "16",
+                 "--out", str(ref_path), "-q"]) == 0
+    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "-q",
+                 "--reference", str(ref_path), "--crop", "4", "4", "8", "8"]) == 0
+    line = capsys.readouterr().out.strip()
+    m = re.fullmatch(r"relMSE (\S+), crop (\S+); less the reference's own noise \(an estimated (\S+), crop (\S+), "
+                     r"from ref.variance.exr\): (\S+), crop (\S+)", line)
+    assert m, line
+    ref = read_image(ref_path)[..., :3].astype(np.float64)
+    noise = reference_noise(ref_path, ref, (4, 4, 8, 8))
+    img = read_image(out)
+    measured = rel_mse(img, ref), rel_mse(img, ref, (4, 4, 8, 8))
+    assert [float(m.group(k)) for k in (3, 4)] == pytest.approx(noise, rel=2e-3)
+    assert float(m.group(5)) == pytest.approx(measured[0] - noise[0], rel=1e-5)
+    assert float(m.group(6)) == pytest.approx(measured[1] - noise[1], rel=1e-5)
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -200,9 +222,10 @@ def test_compare(tmp_path, capsys, reference16):
     with open(tmp_path / "cmp.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert [r["sampler"] for r in rows] == ["random", "bose", "sobol"]
+    assert [r["seed"] for r in rows] == ["0", "0", "0"]
     # bose: 9 or 16 are valid, 9 is nearer 12; sobol: 8 and 16 are equally near, ties go to fewer
     assert [int(r["spp"]) for r in rows] == [12, 9, 8]
-    assert [r["note"] for r in rows] == ["", "nearest valid to 12", "nearest valid to 12"]
+    assert [int(r["spp_asked"]) for r in rows] == [12, 12, 12]
     ref = read_image(reference16)
     for r in rows:
         img = render(load("cornell"), sampler=r["sampler"], spp=int(r["spp"]), seed=0, width=16, height=16).image
@@ -211,13 +234,68 @@ def test_compare(tmp_path, capsys, reference16):
         assert float(r["relmse_crop"]) == pytest.approx(rel_mse(img, ref, (4, 4, 4, 4)), rel=1e-9)
         assert float(r["seconds"]) >= 0
     lines = [ln for ln in md.splitlines() if ln.startswith("| ")]
-    assert lines[0].startswith("| sampler | spp | relMSE (image) | relMSE (crop 4x4 at 4,4) | note |")
+    assert lines[0] == "| sampler | spp | relMSE (image) | relMSE (crop 4x4 at 4,4) | / random | seconds |"
     assert len(lines) == 1 + 3
-    assert lines[2].startswith("| bose | 9 |") and lines[2].endswith("| nearest valid to 12 |")
-    assert lines[1].startswith("| random | 12 |") and lines[1].endswith("|  |")
+    # a substituted count is in the table's own spp column; one seed: values without intervals
+    assert lines[2].startswith(f"| bose | 9 (12 asked: nearest valid) | {float(rows[1]['relmse']):.3g} | ")
+    assert lines[1].startswith(f"| random | 12 | {float(rows[0]['relmse']):.3g} | ")
+    assert f"| {float(rows[1]['relmse']) / float(rows[0]['relmse']):.2f} |" in lines[2]
+    # a reference with no variance file: its noise is said to be unknown, nothing is subtracted
+    assert "its own noise is unknown (no ref.variance.exr beside it" in md
+    assert "one seed: no interval" in md
     fig = read_image(tmp_path / "cmp.png")
     assert fig.ndim == 3 and fig.shape[0] > 50 and fig.shape[1] > fig.shape[0]
     assert sorted(os.listdir(tmp_path)) == ["cmp.csv", "cmp.md", "cmp.png", "ref.exr"]
+
+
+def test_compare_over_seeds_subtracts_the_reference_noise(tmp_path, capsys):
+    """``--seeds N``: N renders per sampler (seeds --seed ..), each cell the mean less the reference's
+    own noise (from its variance file) with a Student-t interval, ratios with ratio_ci's interval:
+    the statistics of ``pyoa study``."""
+    from pyoa.analysis.statistics import mean_ci, ratio_ci
+    from pyoa.render.reference import reference_noise
+
+    ref_path = tmp_path / "ref.exr"
+    assert main(["reference", "cornell", "--size", "16", "16", "--spp", "64", "--pass-spp", "16",
+                 "--out", str(ref_path), "-q"]) == 0
+    assert (tmp_path / "ref.variance.exr").is_file()
+    stem = tmp_path / "cmp"
+    assert main(["compare", "cornell", "--size", "16", "16", "--spp", "9", "--samplers", "bose,random",
+                 "--seed", "5", "--seeds", "3", "--reference", str(ref_path), "--out", str(stem), "-q"]) == 0
+    md = capsys.readouterr().out
+    with open(tmp_path / "cmp.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [(r["sampler"], int(r["seed"])) for r in rows] == [("bose", 5), ("bose", 6), ("bose", 7),
+                                                                ("random", 5), ("random", 6), ("random", 7)]
+    ref = read_image(ref_path)[..., :3].astype(np.float64)
+    for r in rows[::2]:
+        img = render(load("cornell"), sampler=r["sampler"], spp=9, seed=int(r["seed"]), width=16, height=16).image
+        assert float(r["relmse"]) == pytest.approx(rel_mse(img, ref), rel=1e-9)
+    noise, crop_noise = reference_noise(ref_path, ref, (4, 4, 4, 4))
+    assert noise > 0 and crop_noise > 0
+    assert f"adds an estimated {noise:.2g} to every image relMSE and {crop_noise:.2g}" in md
+    values = {n: np.array([float(r["relmse"]) for r in rows if r["sampler"] == n]) for n in ("bose", "random")}
+    crops = {n: np.array([float(r["relmse_crop"]) for r in rows if r["sampler"] == n]) for n in ("bose", "random")}
+    lines = [ln for ln in md.splitlines() if ln.startswith("| ")]
+    for line, name in zip(lines[1:], ("bose", "random")):
+        m, lo, hi = mean_ci(values[name])
+        cm, clo, chi = mean_ci(crops[name])
+        assert line.startswith(f"| {name} | 9 | {m - noise:.3g} ± {(hi - lo) / 2:.2g} | "
+                               f"{cm - crop_noise:.3g} ± {(chi - clo) / 2:.2g} | ")
+    r, lo, hi = ratio_ci(values["random"], values["bose"], shift_a=noise, shift_b=noise)
+    assert f"| {r:.2f} [{lo:.2f}, {hi:.2f}] |" in lines[2]
+    assert "3 seeds (5..7) per sampler" in md
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--seeds", "0"], r"--seeds must be in \[1, 65536\]"),
+    (["--seed", "4294967295", "--seeds", "2"], r"--seed must be in \[0, 4294967294\] \(the first of --seeds"),
+])
+def test_compare_refuses_bad_seeds(tmp_path, capsys, reference16, argv, message):
+    err = run_error(capsys, ["compare", "cornell", "--size", "16", "16", "--spp", "4", "--samplers", "bose",
+                             "--reference", str(reference16), "--out", str(tmp_path / "cmp"), "-q", *argv])
+    assert re.search(message, err), err
+    assert not (tmp_path / "cmp.md").exists()
 
 
 def test_compare_crop_and_errors(tmp_path, capsys, reference16):
