@@ -321,6 +321,7 @@ def _stdout_closed() -> bool:
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
     args = ap.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # what made an image goes into its header
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning

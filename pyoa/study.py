@@ -842,6 +842,7 @@ def run(args) -> int:
     from .render.commands import _check_job_memory, _default_crop, check_seeds
     from .render.image import check_crop, read_reference
     from .render.integrator import RENDERER_VERSION
+    from .render.provenance import command_line, describe
     from .render.reference import reference_noise, render_reference
     from .render.render import plan, resolve_shading
     from .render.scene import load
@@ -931,8 +932,13 @@ def run(args) -> int:
                     passes = ref.key["passes"]
                     if not args.quiet:
                         print(f"reference of {name}: {args.reference_spp} spp in {passes} passes on {where}")
+                    meta = describe(scene, plan(scene, sampler="sobol", spp=pass_spp, seed=0, **planned),
+                                    kind="reference", seed=0, filter=args.filter, shading=shading,
+                                    command=command_line(args.argv) if hasattr(args, "argv") else None,
+                                    passes=passes, pass_spp=pass_spp)
+                    meta["spp"] = args.reference_spp
                     render_reference(eng, scene, out=ref.path, key=ref.key, kwargs=dict(common, sampler="sobol",
-                                     spp=pass_spp), seed=0, quiet=args.quiet, command="pyoa study")
+                                     spp=pass_spp), seed=0, quiet=args.quiet, command="pyoa study", metadata=meta)
                     ref.pixels = read_reference(ref.path, "the study's reference", *dims)
                     if any(r["scene"] == name for r in rows) and not is_reference(rec.get("reference"), ref.path,
                                                                                    ref.pixels):

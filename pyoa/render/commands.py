@@ -28,6 +28,7 @@ from .image import (
 )
 from .layout import MAX_DEPTH
 from .progressive import check_progressive, render_progressive, state_path
+from .provenance import command_line, describe
 from .reference import reference_key, reference_noise, render_reference, variance_path
 from .render import SHADINGS, check_memory, plan, resolve_shading
 from .scene import load
@@ -43,6 +44,12 @@ POST_PIXEL_BYTES = 256
 MAX_SEEDS = 1 << 16
 #: Most passes of ``pyoa reference``: pass seeds hash a uint32 pass index.
 MAX_PASSES = MAX_UINT32 + 1
+
+
+def _command(args) -> str | None:
+    """The command line of this run (``pyoa.cli.main`` keeps it), for the images' headers."""
+    argv = getattr(args, "argv", None)
+    return None if argv is None else command_line(argv)
 
 
 def _size(args) -> dict:
@@ -109,7 +116,7 @@ def cmd_render(args) -> int:
                                   seed=args.seed, base=args.base, **_size(args), max_depth=args.max_depth,
                                   filter=args.filter, first=args.first, backend=args.backend,
                                   shading=args.shading, time_budget=args.time, resume=args.resume,
-                                  quiet=args.quiet)
+                                  quiet=args.quiet, command=_command(args))
         image = pres.image
         if not args.quiet:
             base = f" (base {pres.base})" if pres.base else ""
@@ -123,7 +130,8 @@ def cmd_render(args) -> int:
                             max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
                             shading=args.shading, progress=not args.quiet, base=args.base)
         check_finite(res.image, f"--out {args.out!r} not written")  # before either file is written
-        write_exr(args.out, res.image)
+        write_exr(args.out, res.image, describe(scene, p, kind="render", seed=args.seed, filter=args.filter,
+                                                shading=res.shading, command=_command(args)))
         if args.png:
             write_png(args.png, res.image)
         image = res.image
@@ -340,9 +348,12 @@ def cmd_reference(args) -> int:
                         shading=shading)
     kwargs = dict(sampler=args.sampler, spp=args.pass_spp, **_size(args), max_depth=args.max_depth,
                   filter=args.filter, first=args.first, backend=args.backend, shading=shading)
+    meta = describe(scene, p, kind="reference", seed=args.seed, filter=args.filter, shading=shading,
+                    command=_command(args), passes=passes, pass_spp=args.pass_spp)
+    meta["spp"] = args.spp  # the reference's samples per pixel; the plan's is one pass's
     with engine(args.workers, args.scheduler) as eng:
         _, var = render_reference(eng, scene, out=args.out, key=key, kwargs=kwargs, seed=args.seed,
-                                  quiet=args.quiet)
+                                  quiet=args.quiet, metadata=meta)
     if not args.quiet:
         where = "" if eng.client is None else f" on {eng.description}"
         print(f"reference: {passes} passes x {args.pass_spp} spp{where} -> {args.out}")
@@ -350,6 +361,39 @@ def cmd_reference(args) -> int:
             ref = read_reference(args.out, "--out", p.width, p.height)
             print(f"its own noise: relMSE {relmse_noise(var, ref):.3g} (per-pixel variance of the mean -> "
                   f"{variance_path(args.out)})")
+    return 0
+
+
+#: The order ``pyoa info`` prints an image's attributes in (others follow, sorted).
+INFO_ORDER = ("kind", "command", "scene", "scene_file", "scene_sha256", "width", "height", "sampler", "spp",
+              "seed", "base", "samples", "passes", "pass_spp", "max_depth", "filter", "shading", "layout",
+              "renderer", "version", "git", "cpu")
+
+
+def cmd_info(args) -> int:
+    """``pyoa info FILE ...``: each image's size and what made it (:mod:`pyoa.render.provenance`)."""
+    import json
+
+    from .image import image_info
+    from .provenance import read
+
+    found = {}
+    for path in args.files:  # every file is read before anything is printed: one bad name, one error
+        found[path] = (image_info(path), read(path))
+    if args.json:
+        print(json.dumps({str(p): dict(meta, width_px=info[0], height_px=info[1], channels=info[2])
+                          for p, (info, meta) in found.items()}, indent=2))
+        return 0
+    for path, ((w, h, c, fmt), meta) in found.items():
+        print(f"{path}: {w} x {h}, {c} channels ({fmt})")
+        if not meta:
+            print("  no pyoa metadata (not an image of pyoa render, reference or study, or one from before they "
+                  "kept it)")
+            continue
+        keys = [k for k in INFO_ORDER if k in meta] + sorted(k for k in meta if k not in INFO_ORDER)
+        width = max(map(len, keys))
+        for k in keys:
+            print(f"  {k:{width}s}  {meta[k]}")
     return 0
 
 
@@ -423,6 +467,12 @@ def add_parsers(sub) -> None:
                         "intervals (default 1: one render each, no interval)")
     p.add_argument("--out", default="compare", help="output stem: STEM.md, STEM.csv, STEM.png (default compare)")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("info", help="print what made an image: scene, sampler, spp, seed, settings, pyoa "
+                                    "version and revision, CPU, command line (from its EXR header)")
+    p.add_argument("files", nargs="+", metavar="FILE", help="images written by pyoa (EXR)")
+    p.add_argument("--json", action="store_true", help="print one JSON object, keyed by file")
+    p.set_defaults(func=cmd_info)
 
     p = sub.add_parser("reference", help="render a high-spp reference in resumable passes")
     common(p, 4096)

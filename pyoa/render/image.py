@@ -68,8 +68,11 @@ def check_finite(image: np.ndarray, what: str) -> None:
                          f"the float32 range), first at (x, y) {first}{', ...' if len(xs) > 3 else ''}")
 
 
-def _write(path, pixels: np.ndarray, fmt: str) -> None:
+def _write(path, pixels: np.ndarray, fmt: str, metadata: dict | None = None) -> None:
+    from .provenance import attributes
+
     oiio = _oiio()
+    attrs = attributes(metadata)  # a bad value is refused before anything is written
     h, w, c = pixels.shape
 
     def failed(message: str) -> str:
@@ -84,18 +87,22 @@ def _write(path, pixels: np.ndarray, fmt: str) -> None:
         if out is None:
             raise ValueError(f"cannot write {str(path)!r}: {failed(oiio.geterror())}")
         spec = oiio.ImageSpec(w, h, c, fmt)
+        for name, value in attrs:
+            spec.attribute(name, value)
         if not (out.open(str(tmp), spec) and out.write_image(pixels) and out.close()):
             raise OSError(failed(out.geterror()))
 
 
-def write_exr(path: str | os.PathLike, image: np.ndarray) -> None:
-    """Write a linear float32 RGB image (``(H, W, 3)``) as OpenEXR, atomically.
+def write_exr(path: str | os.PathLike, image: np.ndarray, metadata: dict | None = None) -> None:
+    """Write a linear float32 RGB image (``(H, W, 3)``) as OpenEXR, atomically,
+    with ``metadata`` (str or int values, :func:`pyoa.render.provenance.describe`)
+    in its header as ``pyoa:KEY`` attributes (:func:`pyoa.render.provenance.read`).
 
     A non-finite pixel, or one a float32 cannot hold, is refused (ValueError)."""
     with np.errstate(over="ignore"):  # a value over the float32 range becomes inf, refused just below
         pixels = np.ascontiguousarray(image, dtype=np.float32)
     check_finite(pixels, f"{str(path)!r} not written")
-    _write(path, pixels, "float")
+    _write(path, pixels, "float", metadata)
 
 
 def to_srgb8(image: np.ndarray) -> np.ndarray:

@@ -46,6 +46,7 @@ import numpy as np
 from .. import catalogue
 from .image import check_finite, write_exr, write_png
 from .integrator import RENDERER_VERSION, Stats
+from .provenance import describe
 from .render import plan, render, resolve_shading
 from .state import (
     BadState,
@@ -160,7 +161,8 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
                        base: int | None = None, width: int | None = None, height: int | None = None,
                        max_depth: int | None = None, filter: str = "box", first=None, backend: str | None = None,
                        shading: str | None = None, png=None, time_budget: float | None = None,
-                       resume: bool = False, quiet: bool = True, max_bytes=None) -> ProgressiveResult:
+                       resume: bool = False, quiet: bool = True, max_bytes=None,
+                       command: str | None = None) -> ProgressiveResult:
     """Render ``scene`` progressively to the EXR ``out`` (module docstring).
 
     Parameters
@@ -186,6 +188,9 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
         refused either way (:func:`.state.check_state_file`).
     quiet : bool
         No progress output.
+    command : str, optional
+        The command line that asked for it, written into the EXR's header
+        with the render's settings (:mod:`pyoa.render.provenance`).
 
     Raises
     ------
@@ -214,6 +219,8 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
                height=p.height, max_depth=p.layout.max_depth, sampler=smp.name, base=smp.base, seed=smp.seed,
                filter=filter, first=list(p.layout.names), shading=resolve_shading(shading),
                spp=None if entry.spp_invariant else smp.spp)
+    meta = describe(scene, p, kind="progressive render", seed=smp.seed, filter=filter,
+                    shading=resolve_shading(shading), command=command)
     total, done = None, 0
     if resume and state.exists():
         try:
@@ -255,7 +262,7 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
         done = end
         image = (total / done).astype(np.float32)
         with _held_interrupt():  # Ctrl-C waits until the image, the PNG and the state hold this doubling
-            write_exr(out, image)
+            write_exr(out, image, dict(meta, samples=done))
             if png:
                 write_png(png, image)
             write_state(state, total, "samples", done, key)
@@ -266,7 +273,7 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
             print(f"{done} of {smp.spp} samples per pixel -> {out} ({time.perf_counter() - t_start:.1f} s)")
     result.seconds = time.perf_counter() - t_start
     if not result.written and done:  # resumed a finished render: write its image again
-        write_exr(out, result.image)
+        write_exr(out, result.image, dict(meta, samples=done))
         if png:
             write_png(png, result.image)
     return result

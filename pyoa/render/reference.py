@@ -30,7 +30,15 @@ import numpy as np
 
 from .image import check_finite, write_exr
 from .integrator import RENDERER_VERSION
-from .state import BadState, check_state_file, describe_size, read_state_arrays, scene_digest, state_path, write_state
+from .state import (
+    BadState,
+    check_state_file,
+    describe_size,
+    read_state_arrays,
+    scene_digest,
+    state_path,
+    write_state,
+)
 from .tiles import worker_render
 
 #: Key of the reference passes' seeds (see pass_seed).
@@ -193,11 +201,14 @@ def pass_task(scene, kwargs: dict, seed: int, k: int, threads: int | None):
 
 
 def render_reference(eng, scene, *, out, key: dict, kwargs: dict, seed: int, quiet: bool = False,
-                     command: str = "pyoa reference") -> tuple[np.ndarray, np.ndarray | None]:
+                     command: str = "pyoa reference",
+                     metadata: dict | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """Render (or resume) the reference of ``key`` on the engine ``eng``
     and write ``out`` and its variance (:func:`variance_path`); returns
     ``(mean, variance)``. ``kwargs`` are :func:`~pyoa.render.render.render`'s
-    for one pass (the seed aside); every check has been made by the caller."""
+    for one pass (the seed aside); every check has been made by the caller.
+    ``metadata`` (:func:`pyoa.render.provenance.describe`) goes into both
+    files' headers, with their kinds."""
     from tqdm.auto import tqdm
 
     from .scene_source import source_of
@@ -214,9 +225,11 @@ def render_reference(eng, scene, *, out, key: dict, kwargs: dict, seed: int, qui
             acc.add(k, image)
             bar.update(1)
     mean, var = acc.mean(), acc.variance()
-    write_exr(out, mean)
+    meta = metadata or {}
+    write_exr(out, mean, dict(meta, kind="reference") if meta else None)
     if var is not None:
-        write_exr(variance_path(out), var.astype(np.float32))
+        write_exr(variance_path(out), var.astype(np.float32),
+                  dict(meta, kind="reference variance") if meta else None)
     else:
         variance_path(out).unlink(missing_ok=True)  # not a stale one of another run
     state.unlink(missing_ok=True)

@@ -1,0 +1,111 @@
+"""What made an image: the settings, software and machine written into every EXR pyoa renders.
+
+A figure in a paper should lead back to the command that made it. Every EXR
+that ``pyoa render``, ``pyoa reference`` (its image and its variance) and a
+progressive render write carries, in its header, string and integer
+attributes named ``pyoa:KEY`` (OpenImageIO's ``ImageSpec.attribute``; EXR
+keeps any named attribute, as pbrt-v4 keeps its render metadata there too):
+
+========================  =====================================================
+``pyoa:kind``             ``render``, ``progressive render``, ``reference``,
+                          ``reference variance``
+``pyoa:scene``            the scene's name, ``pyoa:scene_file`` its file and
+                          ``pyoa:scene_sha256`` the digest of its file and
+                          world-space triangles (what a resumed job checks)
+``pyoa:width/height``     the image size
+``pyoa:sampler``          its catalogue name; ``pyoa:spp``, ``pyoa:seed``,
+                          ``pyoa:base`` (faure), ``pyoa:samples`` (a
+                          progressive render: samples so far)
+``pyoa:passes``           a reference: passes and ``pyoa:pass_spp``
+``pyoa:max_depth``        path length, ``pyoa:filter``, ``pyoa:shading``,
+                          ``pyoa:layout`` (the sampler dimension of each
+                          integrand dimension, as ``pyoa render`` prints it)
+``pyoa:renderer``         :data:`~pyoa.render.integrator.RENDERER_VERSION`
+``pyoa:version``          pyoa's version; ``pyoa:git`` the revision of a
+                          source checkout (``+dirty`` with local changes)
+``pyoa:cpu``              the host CPU (:func:`pyoa.hostcpu.host_cpu`)
+``pyoa:command``          the command line, when written by the CLI
+========================  =====================================================
+
+:func:`read` gives them back as a dict (``pyoa info FILE`` prints them).
+"""
+
+from __future__ import annotations
+
+import functools
+import shlex
+import subprocess
+from pathlib import Path
+
+#: Prefix of pyoa's attributes in an image header.
+PREFIX = "pyoa:"
+
+
+@functools.lru_cache(maxsize=1)
+def git_revision() -> str:
+    """The git revision of pyoa's source checkout (``+dirty`` when tracked files differ from it), or
+    ``""`` for an installed copy that is not a checkout, or when git is missing or slow."""
+    root = Path(__file__).resolve().parents[2]
+    if not (root / ".git").exists():
+        return ""
+    try:
+        rev = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
+                             timeout=5, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=5, check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return ""
+    return rev + ("+dirty" if dirty else "")
+
+
+def command_line(argv) -> str:
+    """``pyoa ARGS`` as a shell would take it back (quoted where needed)."""
+    return shlex.join(["pyoa", *map(str, argv)])
+
+
+def describe(scene, p, *, kind: str, seed: int, filter: str, shading: str, command: str | None = None,
+             **extra) -> dict:
+    """The attributes of an image of ``scene`` rendered as planned by ``p``
+    (:func:`pyoa.render.render.plan`), with the settings the plan does not
+    hold; ``extra`` adds kind-specific ones (``samples``, ``passes``,
+    ``pass_spp``). Values are str or int."""
+    from .. import __version__
+    from ..hostcpu import host_cpu
+    from .integrator import RENDERER_VERSION
+    from .state import scene_digest
+
+    smp = p.sampler
+    meta = {"kind": kind, "scene": scene.name, "scene_file": str(scene.path), "scene_sha256": scene_digest(scene),
+            "width": p.width, "height": p.height, "sampler": smp.name, "spp": smp.spp, "seed": int(seed)}
+    if smp.base is not None:
+        meta["base"] = int(smp.base)
+    meta.update({k: v for k, v in extra.items() if v is not None})
+    meta.update({"max_depth": p.layout.max_depth, "filter": filter, "shading": shading,
+                 "layout": p.layout.describe(), "renderer": RENDERER_VERSION, "version": __version__,
+                 "git": git_revision(), "cpu": host_cpu().describe()})
+    if command:
+        meta["command"] = command
+    return {k: v for k, v in meta.items() if v != ""}
+
+
+def attributes(meta: dict | None) -> list[tuple[str, str | int]]:
+    """``meta`` as (header name, value) pairs: names prefixed, values str or int (others refused)."""
+    out = []
+    for key, value in (meta or {}).items():
+        if isinstance(value, bool) or not isinstance(value, (str, int)):
+            raise TypeError(f"image metadata {key!r} must be a str or an int, got {type(value).__name__}")
+        out.append((PREFIX + key, value))
+    return out
+
+
+def read(path) -> dict:
+    """The ``pyoa:`` attributes of an image's header as ``{key: value}`` (empty for an image pyoa did not
+    write, or wrote before it kept them)."""
+    from .image import _open
+
+    inp = _open(path)
+    try:
+        spec = inp.spec()
+        return {a.name[len(PREFIX):]: a.value for a in spec.extra_attribs if a.name.startswith(PREFIX)}
+    finally:
+        inp.close()
