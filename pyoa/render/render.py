@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numbers
 import os
+import sys
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -352,12 +353,21 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         return st
 
     bar = None
+    t0 = time.perf_counter()
     if progress:
         from tqdm.auto import tqdm
 
+        # The first batch runs before the bar starts: it pays the one-time costs (numba compiling the
+        # renderer after an install, the sampler's OpenCL build, Embree's scene), which would otherwise
+        # freeze the bar at its first step with an ETA of minutes. Said when it is the long one.
+        if getattr(integ, "needs_compiling", lambda: False)():
+            print("compiling the renderer with numba (once per installed version of pyoa, 15-60 s) ...",
+                  file=sys.stderr, flush=True)
+        total.add(run(batches[0]))
         what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
-        bar = tqdm(total=n_pixels, unit="px", desc=f"{scene.name} {sampler} {what}")
-    t0 = time.perf_counter()
+        bar = tqdm(total=n_pixels, initial=batches[0][1] - batches[0][0], unit="px",
+                   desc=f"{scene.name} {sampler} {what}")
+        batches = batches[1:]
     workers = max(1, min(threads or os.cpu_count() or 1, len(batches)))
     try:
         with ThreadPoolExecutor(workers) as pool:

@@ -417,3 +417,24 @@ def test_reference_errors(tmp_path, capsys):
     err = run_error(capsys, ["reference", "nosuchscene", "--out", str(tmp_path / "r.exr"), "-q"])
     assert "no such scene" in err
     assert listing(tmp_path) == []
+
+
+def test_the_first_render_says_it_is_compiling_and_its_bar_starts_after(tmp_path):
+    """After an install numba compiles the renderer (15-60 s) before the first path: the render says so,
+    and its progress bar starts once that is done (it used to sit at its first step with an ETA of
+    minutes). Later renders, from numba's cache, say nothing of it."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))  # an empty cache: a fresh install
+    cmd = [sys.executable, "-m", "pyoa", "render", "dof7d", "--size", "32", "32", "--spp", "4",
+           "--out", str(tmp_path / "a.exr")]
+    first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    assert first.returncode == 0, first.stderr
+    said = first.stderr.find("compiling the renderer with numba (once per installed version of pyoa")
+    assert said >= 0, first.stderr
+    assert "px" not in first.stderr[:said]  # no bar before the message
+    second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    assert second.returncode == 0, second.stderr
+    assert "compiling the renderer" not in second.stderr
+    assert "px" in second.stderr  # the bar itself is still shown

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import ctypes
 import time
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -305,6 +306,15 @@ class CompiledIntegrator:
         #: paths traced together (:data:`WAVEFRONT`; any size gives the same image)
         self.wavefront = WAVEFRONT
         self.timings = {"camera": 0.0, "embree": 0.0, "shading": 0.0, "host": 0.0}
+
+    @staticmethod
+    def needs_compiling() -> bool:
+        """Whether numba's on-disk cache holds no compiled :func:`render_paths` for these sources
+        (:func:`pyoa.render.compiled.cache_dir`): the first render after an install or an update
+        then compiles the renderer (15-60 s) before its first path."""
+        from . import cache_dir
+
+        return not any(Path(cache_dir()).glob("*/integrator.render_paths-*.nbi"))
 
     def radiance(self, pixel, sample_index, x, seed: int = 0):
         """Radiance (RGB, float64) of the camera paths ``(pixel, sample)`` whose
