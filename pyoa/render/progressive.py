@@ -157,6 +157,17 @@ class ProgressiveResult:
     stats: Stats = field(default_factory=Stats)
 
 
+def _bar(name: str, smp, done: int, quiet: bool):
+    """The progress bar of a progressive render (None when quiet): one bar for the whole render, in
+    samples per pixel, so that it moves inside a block too (the last block holds half the samples)."""
+    if quiet:
+        return None
+    from tqdm.auto import tqdm
+
+    return tqdm(total=smp.spp, initial=done, unit="spp", desc=f"{name} {smp.name}",
+                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total} spp [{elapsed}<{remaining}{postfix}]")
+
+
 def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, seed: int = 0,
                        base: int | None = None, width: int | None = None, height: int | None = None,
                        max_depth: int | None = None, filter: str = "box", first=None, backend: str | None = None,
@@ -244,33 +255,45 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
     integrator = None
     block = np.empty_like(total)
     last_rate = None  # seconds per sample of the previous block
-    for end in block_ends(done, smp.spp):
-        n = end - done
-        elapsed = time.perf_counter() - t_start
-        if time_budget is not None and last_rate is not None and elapsed + last_rate * n > time_budget:
-            result.stopped_by_time = True
-            break
-        t0 = time.perf_counter()
-        res = render(scene, sampler=sampler, spp=smp.spp, seed=seed, width=p.width, height=p.height,
-                     max_depth=max_depth, filter=filter, first=first, backend=backend, shading=shading,
-                     max_bytes=max_bytes, base=smp.base, samples=range(done, end), sums=block,
-                     integrator=integrator)
-        integrator = res.integrator
-        last_rate = (time.perf_counter() - t0) / n
-        check_finite(res.image, f"--out {str(out)!r} not updated past {done} samples")
-        total += block
-        done = end
-        image = (total / done).astype(np.float32)
-        with _held_interrupt():  # Ctrl-C waits until the image, the PNG and the state hold this doubling
-            write_exr(out, image, dict(meta, samples=done))
-            if png:
-                write_png(png, image)
-            write_state(state, total, "samples", done, key)
-        result.stats.add(res.stats)
-        result.written.append(done)
-        result.image, result.samples = image, done
-        if not quiet:
-            print(f"{done} of {smp.spp} samples per pixel -> {out} ({time.perf_counter() - t_start:.1f} s)")
+    bar = _bar(scene.name, smp, done, quiet)
+    try:
+        for end in block_ends(done, smp.spp):
+            n = end - done
+            elapsed = time.perf_counter() - t_start
+            if bar is not None and time_budget is not None:
+                bar.set_postfix_str(f"--time {time_budget:g} s: {max(0.0, time_budget - elapsed):.0f} s left")
+            if time_budget is not None and last_rate is not None and elapsed + last_rate * n > time_budget:
+                result.stopped_by_time = True
+                if bar is not None:
+                    bar.write(f"the next doubling, to {end} samples per pixel, would end past --time "
+                              f"{time_budget:g} s (about {elapsed + last_rate * n:.0f} s): stopped")
+                break
+            t0 = time.perf_counter()
+            res = render(scene, sampler=sampler, spp=smp.spp, seed=seed, width=p.width, height=p.height,
+                         max_depth=max_depth, filter=filter, first=first, backend=backend, shading=shading,
+                         max_bytes=max_bytes, base=smp.base, samples=range(done, end), sums=block,
+                         integrator=integrator, progress=bar if bar is not None else False)
+            integrator = res.integrator
+            last_rate = (time.perf_counter() - t0) / n
+            check_finite(res.image, f"--out {str(out)!r} not updated past {done} samples")
+            total += block
+            done = end
+            image = (total / done).astype(np.float32)
+            with _held_interrupt():  # Ctrl-C waits until the image, the PNG and the state hold this doubling
+                write_exr(out, image, dict(meta, samples=done))
+                if png:
+                    write_png(png, image)
+                write_state(state, total, "samples", done, key)
+            result.stats.add(res.stats)
+            result.written.append(done)
+            result.image, result.samples = image, done
+            if bar is not None:
+                bar.n = done  # whole again: the batches' fractions add up to the block but for rounding
+                bar.refresh()
+                bar.write(f"{done} of {smp.spp} samples per pixel -> {out} ({time.perf_counter() - t_start:.1f} s)")
+    finally:
+        if bar is not None:
+            bar.close()
     result.seconds = time.perf_counter() - t_start
     if not result.written and done:  # resumed a finished render: write its image again
         write_exr(out, result.image, dict(meta, samples=done))

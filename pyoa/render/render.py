@@ -256,8 +256,13 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         Camera paths per batch (rounded to whole pixels).
     threads : int, optional
         Worker threads (default: the number of CPUs).
-    progress : bool
-        Show a tqdm progress bar.
+    progress : bool or tqdm-like, optional
+        True: show a tqdm progress bar of this render's pixels. An object
+        with ``update(n)`` (an open tqdm bar): advance it by the samples per
+        pixel each batch completes, as a fraction of the image
+        (``samples x batch pixels / image pixels``), so that one bar can
+        follow several renders of the same image in samples per pixel (a
+        progressive render's blocks do).
     shading : {"numba", "numpy"}, optional
         ``"numba"`` (default): shading compiled with numba, Embree called from
         it (:mod:`pyoa.render.compiled`); ``"numpy"``: the NumPy reference
@@ -354,20 +359,23 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
 
     bar = None
     t0 = time.perf_counter()
+    outer = progress if hasattr(progress, "update") else None
     if progress:
-        from tqdm.auto import tqdm
-
         # The first batch runs before the bar starts: it pays the one-time costs (numba compiling the
         # renderer after an install, the sampler's OpenCL build, Embree's scene), which would otherwise
         # freeze the bar at its first step with an ETA of minutes. Said when it is the long one.
         if getattr(integ, "needs_compiling", lambda: False)():
             print("compiling the renderer with numba (once per installed version of pyoa, 15-60 s) ...",
                   file=sys.stderr, flush=True)
-        total.add(run(batches[0]))
-        what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
-        bar = tqdm(total=n_pixels, initial=batches[0][1] - batches[0][0], unit="px",
-                   desc=f"{scene.name} {sampler} {what}")
-        batches = batches[1:]
+        (p0, p1), batches = batches[0], batches[1:]
+        total.add(run((p0, p1)))
+        if outer is not None:
+            outer.update(n * (p1 - p0) / (width * height))
+        else:
+            from tqdm.auto import tqdm
+
+            what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
+            bar = tqdm(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {sampler} {what}")
     workers = max(1, min(threads or os.cpu_count() or 1, len(batches)))
     try:
         with ThreadPoolExecutor(workers) as pool:
@@ -375,6 +383,8 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
                 total.add(st)
                 if bar is not None:
                     bar.update(p1 - p0)
+                if outer is not None:
+                    outer.update(n * (p1 - p0) / (width * height))
     finally:
         if bar is not None:
             bar.close()

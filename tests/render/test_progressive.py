@@ -203,3 +203,27 @@ def test_cli_progressive_time_and_resume(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["render", "cornell", "--sampler", "sobol", "--base", "5", "--out", str(out)])
     assert "sobol takes no base" in capsys.readouterr().err
+
+
+def test_progress_moves_inside_a_block_in_samples_per_pixel(cornell, tmp_path, capsys):
+    """The progressive bar counts samples per pixel and advances with every batch of a block, not only
+    when a block ends (the last block holds half the samples: it used to run minutes in silence)."""
+
+    class Bar:
+        def __init__(self):
+            self.steps = []
+
+        def update(self, n):
+            self.steps.append(n)
+
+    bar = Bar()
+    ref = render(cornell, sampler="faure", spp=8, width=12, height=10, samples=range(4, 8), batch_paths=40)
+    res = render(cornell, sampler="faure", spp=8, width=12, height=10, samples=range(4, 8), batch_paths=40,
+                 progress=bar)
+    np.testing.assert_array_equal(res.image, ref.image)  # the same bits with a bar
+    assert len(bar.steps) == 12  # 40 paths = 10 pixels of 4 samples: 12 batches of the 120 pixels
+    assert sum(bar.steps) == pytest.approx(4)  # the block's 4 samples per pixel
+    render_progressive(cornell, out=tmp_path / "p.exr", sampler="faure", spp=8, width=12, height=10,
+                       quiet=False, time_budget=1e6)
+    err = capsys.readouterr().err
+    assert "8.0/8 spp" in err and "--time 1e+06 s:" in err
