@@ -21,6 +21,24 @@ SAMPLERS: dict[str, Construction] = {
 }
 
 
+#: Names that users of pbrt-v4 and Mitsuba 3 type, each for the pyoa sampler that does the same job
+#: (alias -> (pyoa name, where the name comes from)). :func:`get` accepts them; :func:`pyoa.samplers`
+#: lists them in their sampler's description. A sampler built by an alias carries the pyoa name.
+ALIASES: dict[str, tuple[str, str]] = {
+    "independent": ("random", "pbrt-v4, Mitsuba 3"),
+    "stratified": ("jittered2d", "pbrt-v4, Mitsuba 3"),
+    "multijitter": ("cmj2d", "Mitsuba 3"),
+    "orthogonal": ("bose", "Mitsuba 3, Jarosz et al. 2019"),
+    "paddedsobol": ("sobol02", "pbrt-v4"),
+    "ldsampler": ("sobol02", "Mitsuba 3"),
+}
+
+
+def aliases_of(name: str) -> list[str]:
+    """The :data:`ALIASES` of the pyoa sampler ``name``."""
+    return [a for a, (n, _) in ALIASES.items() if n == name]
+
+
 def names(family: str | None = None) -> list[str]:
     """The sampler names, of one family (``"oa"``, ``"baseline"`` or
     ``"progressive"``) or all."""
@@ -28,13 +46,17 @@ def names(family: str | None = None) -> list[str]:
 
 
 def get(name: str) -> Construction:
-    """Look up a construction by name, with an error that lists the valid ones."""
+    """Look up a construction by name (or a pbrt/Mitsuba name in :data:`ALIASES`), with an error that
+    lists the valid ones."""
     if not isinstance(name, str):
         raise TypeError(f"sampler name must be a str, got {type(name).__name__}")
+    key = name.lower()
+    key = ALIASES[key][0] if key in ALIASES else key
     try:
-        return SAMPLERS[name.lower()]
+        return SAMPLERS[key]
     except KeyError:
-        raise ValueError(f"unknown sampler {name!r}; valid: {', '.join(SAMPLERS)}") from None
+        raise ValueError(f"unknown sampler {name!r}; valid: {', '.join(SAMPLERS)} (or the pbrt/Mitsuba names "
+                         f"{', '.join(ALIASES)})") from None
 
 
 def valid_spp(name: str, near: int | None = None, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:

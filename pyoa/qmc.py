@@ -1,7 +1,9 @@
 """pyoa's samplers as a :class:`scipy.stats.qmc.QMCEngine`.
 
-:class:`OrthogonalArray` wraps any of pyoa's samplers (the orthogonal arrays
-and the comparison samplers) in SciPy's QMC engine interface, so they work
+:class:`PyoaEngine` wraps any of pyoa's samplers (the orthogonal arrays
+and the comparison samplers) in SciPy's QMC engine interface (its first
+name, :class:`OrthogonalArray`, is kept: the same engine, whose default
+sampler is the ``bose`` orthogonal array), so they work
 with ``random``, ``integers``, ``reset``, ``fast_forward``,
 :func:`scipy.stats.qmc.scale`, :func:`scipy.stats.qmc.discrepancy` and
 :func:`scipy.integrate.qmc_quad`.
@@ -24,7 +26,7 @@ from .catalogue_types import MAX_DIMS, MAX_UINT32
 from .samplers import ENV_MAX_BYTES, Sampler, trial_options
 from .units import format_bytes
 
-__all__ = ["OrthogonalArray", "DEFAULT_SPP_TARGET"]
+__all__ = ["PyoaEngine", "OrthogonalArray", "DEFAULT_SPP_TARGET"]
 
 #: Without ``spp=``, the engine uses the sampler's valid count nearest to this
 #: (ties towards fewer points): 121 = 11^2 for ``bose``, 128 for ``sobol``...
@@ -49,7 +51,7 @@ def _draw_seed(rng) -> int:
     return int(rng.randint(0, MAX_UINT32 + 1, dtype=np.int64))
 
 
-class OrthogonalArray(qmc.QMCEngine):
+class PyoaEngine(qmc.QMCEngine):
     r"""Engine drawing from pyoa's randomized orthogonal arrays (and comparison samplers).
 
     An orthogonal array OA(N, d, s, t) is an N x d table of symbols
@@ -239,15 +241,19 @@ class OrthogonalArray(qmc.QMCEngine):
         d = int(d)
         if d > MAX_DIMS:
             raise ValueError(f"d must be at most {MAX_DIMS} (2**20), got {d}")
-        if not isinstance(sampler, str) or sampler.lower() not in catalogue.SAMPLERS:
+        if not isinstance(sampler, str):
             raise ValueError(f"{sampler!r} is not a valid sampler. It must be one of "
                              f"{list(catalogue.SAMPLERS)!r}")
-        name = catalogue.SAMPLERS[sampler.lower()].name
+        try:
+            name = catalogue.get(sampler).name
+        except ValueError:
+            raise ValueError(f"{sampler!r} is not a valid sampler. It must be one of {list(catalogue.SAMPLERS)!r} "
+                             f"(or the pbrt/Mitsuba names {list(catalogue.ALIASES)!r})") from None
 
         # SciPy 1.17's engines take `rng` (normalized by np.random.default_rng)
         # and, during the SPEC 7 transition, the legacy `seed` (used as given).
         if rng is not None and seed is not None:
-            raise TypeError("OrthogonalArray() got multiple values for argument now known as `rng`. "
+            raise TypeError(f"{type(self).__name__}() got multiple values for argument now known as `rng`. "
                             "Specify one of `rng` or `seed`.")
         rng = seed if seed is not None else np.random.default_rng(rng)
         if hasattr(qmc.QMCEngine, "_initialize"):
@@ -281,7 +287,7 @@ class OrthogonalArray(qmc.QMCEngine):
             return super().__repr__()
         extra = f", offset={smp.offset!r}" if smp.offset is not None else ""
         extra += f", base={smp.base}" if smp.base is not None else ""
-        return (f"OrthogonalArray(d={self.d}, spp={self.spp}, sampler={self.sampler_name!r}{extra}, "
+        return (f"{type(self).__name__}(d={self.d}, spp={self.spp}, sampler={self.sampler_name!r}{extra}, "
                 f"pyoa_seed={self.pyoa_seed}; s={self.s}, strength={self.strength}, "
                 f"block_dims={self.block_dims}; num_generated={self.num_generated})")
 
@@ -364,7 +370,7 @@ class OrthogonalArray(qmc.QMCEngine):
             )
         return self.random(m * self.spp)
 
-    def fast_forward(self, n) -> OrthogonalArray:
+    def fast_forward(self, n) -> PyoaEngine:
         """Fast-forward the sequence by `n` positions, without generating them.
 
         Parameters
@@ -374,7 +380,7 @@ class OrthogonalArray(qmc.QMCEngine):
 
         Returns
         -------
-        engine : OrthogonalArray
+        engine : PyoaEngine
             The fast-forwarded engine.
         """
         n = _count("n", n)
@@ -382,13 +388,19 @@ class OrthogonalArray(qmc.QMCEngine):
         self.num_generated += n
         return self
 
-    def reset(self) -> OrthogonalArray:
+    def reset(self) -> PyoaEngine:
         """Reset the engine to base state: array 0, point 0.
 
         Returns
         -------
-        engine : OrthogonalArray
+        engine : PyoaEngine
             Engine reset to its base state.
         """
         super().reset()
         return self
+
+
+class OrthogonalArray(PyoaEngine):
+    """:class:`PyoaEngine` under its first name (kept for the code that uses it): the same engine,
+    whose default sampler is the ``bose`` orthogonal array. For another sampler (``sampler="sobol"``),
+    ``PyoaEngine`` says what it is."""

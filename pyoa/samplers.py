@@ -51,8 +51,14 @@ def trial_options(name: str, options: dict) -> dict:
 
 
 def samplers() -> dict[str, str]:
-    """The sampler names :func:`sampler` accepts, each with a one-line description."""
-    return {name: c.description for name, c in catalogue.SAMPLERS.items()}
+    """The sampler names :func:`sampler` accepts, each with a one-line description; a sampler that
+    pbrt-v4 or Mitsuba 3 users know by another name says so (``"also: independent (pbrt-v4, Mitsuba
+    3)"``), and that name is accepted too (:data:`pyoa.catalogue.ALIASES`)."""
+    out = {}
+    for name, c in catalogue.SAMPLERS.items():
+        also = [f"{a} ({catalogue.ALIASES[a][1]})" for a in catalogue.aliases_of(name)]
+        out[name] = c.description + (f"; also: {', '.join(also)}" if also else "")
+    return out
 
 
 #: cgroup files that hold a container's memory limit (v2, then v1); "max" or

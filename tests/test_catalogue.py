@@ -306,3 +306,34 @@ def test_claims_fail_on_wrong_points():
         with pytest.raises(AssertionError):
             check_claim(claim, x, claim.kind)
     assert math.isqrt(64) == 8
+
+
+# -- the names pbrt-v4 and Mitsuba 3 users type ----------------------------------------------------
+
+
+def test_pbrt_and_mitsuba_names_are_accepted_and_listed():
+    import pyoa
+    from pyoa.qmc import OrthogonalArray, PyoaEngine
+
+    for alias, (name, where) in catalogue.ALIASES.items():
+        assert alias not in catalogue.SAMPLERS  # an alias never hides a pyoa name
+        assert catalogue.get(alias) is catalogue.SAMPLERS[name]
+        assert catalogue.get(alias.upper()) is catalogue.SAMPLERS[name]
+        assert f"{alias} ({where})" in pyoa.samplers()[name]
+    spp = {"random": 16, "jittered2d": 16, "cmj2d": 16, "bose": 16, "sobol02": 16}
+    for alias, (name, _) in catalogue.ALIASES.items():
+        a = pyoa.sampler(alias, spp=spp[name], dims=4, seed=3)
+        assert a.name == name  # it carries the pyoa name
+        np.testing.assert_array_equal(a.generate(pixels=range(3)),
+                                      pyoa.sampler(name, spp=spp[name], dims=4, seed=3).generate(pixels=range(3)))
+    assert set(pyoa.samplers()) == set(catalogue.SAMPLERS)  # listing them adds no sampler twice
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    for alias, (name, _) in catalogue.ALIASES.items():
+        assert f"`{alias}`" in readme and f"(`{name}`)" in readme
+    with pytest.raises(ValueError, match=r"or the pbrt/Mitsuba names independent, stratified"):
+        catalogue.get("nosuch")
+    # the scipy engine: a neutral name for any sampler, the first one kept
+    e, o = PyoaEngine(d=3, sampler="independent", spp=16, rng=5), OrthogonalArray(d=3, sampler="random", spp=16, rng=5)
+    np.testing.assert_array_equal(e.random(32), o.random(32))
+    assert repr(e).startswith("PyoaEngine(d=3, spp=16, sampler='random'")
+    assert repr(o).startswith("OrthogonalArray(d=3")

@@ -271,7 +271,9 @@ def test_samplers_listing():
 
     # every registered sampler, OA constructions first, with its description
     assert list(names) == list(catalogue.SAMPLERS)
-    assert names == {n: c.description for n, c in catalogue.SAMPLERS.items()}
+    for n, c in catalogue.SAMPLERS.items():  # its description, and the pbrt/Mitsuba names it answers to
+        also = [f"{a} ({catalogue.ALIASES[a][1]})" for a in catalogue.aliases_of(n)]
+        assert names[n] == c.description + (f"; also: {', '.join(also)}" if also else "")
     assert {"bose", "bush", "cmjnd", "random", "sobol"} <= set(names)
     assert all(isinstance(v, str) and v for v in names.values())
 
