@@ -662,15 +662,17 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
     return "\n".join(lines)
 
 
-def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
-    """Error against spp on log-log axes, one panel per scene, one line per
-    sampler with its 95 % band (Matplotlib's Agg canvas, written atomically)."""
+def figure(table: dict, scenes: list[str], samplers: list[str]):
+    """The study's figure (Matplotlib's Agg canvas): error against spp on log-log axes, one panel per
+    scene, one line per sampler with its 95 % band, the x axis labelled with the counts asked for;
+    None when no scene of ``scenes`` has rows."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    from matplotlib.ticker import FixedFormatter, FixedLocator, NullLocator
 
     scenes = [s for s in scenes if s in table]
     if not scenes:
-        return
+        return None
     cols = min(len(scenes), 2)
     rows_ = -(-len(scenes) // cols)
     fig = Figure(figsize=(6.0 * cols, 4.6 * rows_), dpi=100, layout="constrained")
@@ -701,11 +703,26 @@ def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
             band = keep & np.isfinite(lo) & (lo > 0)
             if band.any():
                 ax.fill_between(n[band], lo[band], hi[band], color=line.get_color(), alpha=0.18, lw=0)
+        # the counts asked for, as plain numbers (a log axis alone labels 2 x 10^1 and leaves the rest
+        # blank); a sampler's nearest valid count is plotted where it is, unlabelled
+        counts = sorted({asked for by in table[scene].values() for asked in by})
+        ax.xaxis.set_major_locator(FixedLocator(counts))
+        ax.xaxis.set_major_formatter(FixedFormatter([str(c) for c in counts]))
+        ax.xaxis.set_minor_locator(NullLocator())
         ax.set_title(scene)
         ax.set_xlabel("samples per pixel")
         ax.set_ylabel("relMSE (reference noise removed)")
         ax.grid(True, which="both", lw=0.3, alpha=0.5)
         ax.legend(fontsize="x-small", title="sampler (slope)", title_fontsize="x-small")
+    return fig
+
+
+def plot(path, table: dict, scenes: list[str], samplers: list[str]) -> None:
+    """Error against spp on log-log axes, one panel per scene, one line per
+    sampler with its 95 % band (:func:`figure`), written atomically as a PNG."""
+    fig = figure(table, scenes, samplers)
+    if fig is None:
+        return
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         fig.savefig(fh, format="png")
 

@@ -355,3 +355,18 @@ def test_pass_variance_refuses_bad_inputs():
         pass_variance(np.zeros((2, 2)), np.zeros((2, 3)), 4)
     with pytest.raises(TypeError):
         pass_variance(["a"], [1.0], 2)
+
+
+def test_study_figure_labels_the_counts_asked_for():
+    """The study plot's x axis reads the spp values of the study (16, 64, 256, 1024), not "2 x 10^1";
+    a nearest valid count (bose 9 for 10) is plotted where it is but not labelled."""
+    from pyoa import study
+
+    rows = [dict(scene="dof7d", sampler=n, spp_asked=a, spp=(9 if (n, a) == ("bose", 10) else a), seed=k,
+                 relmse=1.0 / a * (1 + 0.1 * k), relmse_crop=1.0 / a, mse=0.0, seconds=0.1)
+            for n in ("bose", "random") for a in (10, 64, 1000) for k in range(3)]
+    fig = study.figure(study.cells(rows, {}), ["dof7d"], ["bose", "random"])
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["10", "64", "1000"]
+    assert list(ax.get_xticks()) == [10, 64, 1000]
+    assert study.figure(study.cells(rows, {}), ["cornell"], ["bose"]) is None

@@ -223,16 +223,15 @@ def cmd_compare(args) -> int:
         wr.writeheader()
         wr.writerows(rows)
         tmp.write_text(buf.getvalue())
-    x, y, w, h = crop
-    crop_figure(png_path, crops, ref[y:y + h, x:x + w])
+    compare_figure(png_path, crops, ref, crop)
     if not args.quiet:
         print(f"-> {md_path}, {csv_path}, {png_path}")
     return 0
 
 
 def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, crops: list) -> dict:
-    """Render one sampler and seed of ``pyoa compare`` on ``eng``: its CSV row; the crop of each
-    sampler's first seed is appended to ``crops`` (the figure)."""
+    """Render one sampler and seed of ``pyoa compare`` on ``eng``: its CSV row; what the figure shows of
+    each sampler's first seed (:func:`figure_panels`) is appended to ``crops``."""
     res = render_on(eng, scene, sampler=name, spp=spp, seed=seed, **_size(args), max_depth=args.max_depth,
                     filter=args.filter, first=args.first, backend=args.backend, shading=args.shading,
                     progress=not args.quiet)
@@ -240,8 +239,7 @@ def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, cr
     row = dict(sampler=name, spp_asked=args.spp, spp=spp, seed=seed, relmse=rel_mse(res.image, ref),
                relmse_crop=rel_mse(res.image, ref, crop), seconds=round(res.seconds, 3))
     if seed == args.seed:
-        x, y, w, h = crop
-        crops.append((name, spp, res.image[y:y + h, x:x + w]))
+        crops.append((name, spp, figure_panels(res.image, ref, crop)))
     if not args.quiet:
         print(f"{name:12s} {spp:6d} spp  seed {seed:<4d} relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
               f"({res.seconds:.1f} s)")
@@ -302,24 +300,77 @@ def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], nois
     return "\n".join(lines) + "\n"
 
 
-def crop_figure(path, crops, ref_crop) -> None:
-    """The crops side by side with the reference's, labelled (matplotlib), written atomically."""
-    import matplotlib
+#: Longest side of the full images in ``pyoa compare``'s figure (larger renders are shown block-averaged).
+FIGURE_SIDE = 384
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+def _shrink(a, k: int):
+    """``a`` (H, W, ...) averaged over k x k blocks (the edge rows and columns that do not fill a block
+    dropped): what the figure shows of an image larger than :data:`FIGURE_SIDE`."""
+    if k <= 1:
+        return a
+    h, w = (a.shape[0] // k) * k, (a.shape[1] // k) * k
+    return a[:h, :w].reshape(h // k, k, w // k, k, *a.shape[2:]).mean(axis=(1, 3))
+
+
+def figure_panels(image, ref, crop) -> tuple:
+    """What ``pyoa compare``'s figure keeps of one render: the full image and its per-pixel relative squared
+    error ``mean over channels of (I - R)^2 / (R^2 + 0.01)`` (the relMSE's terms), both shrunk to at most
+    :data:`FIGURE_SIDE` pixels a side, and the crop at full resolution."""
+    import numpy as np
+
+    x, y, w, h = crop
+    err = ((image.astype(np.float64) - ref) ** 2 / (ref.astype(np.float64) ** 2 + 1e-2)).mean(axis=2)
+    k = max(1, -(-max(image.shape[:2]) // FIGURE_SIDE))
+    return _shrink(image, k), _shrink(err, k), image[y:y + h, x:x + w], k
+
+
+def compare_figure(path, panels, ref, crop) -> None:
+    """``pyoa compare``'s PNG, as papers show sampler comparisons: per sampler (its first seed) the full
+    image with the crop outlined, the crop at full resolution, and the per-pixel error map in false
+    colour on one logarithmic scale for every sampler, with its colour bar; the reference's image and
+    crop in the last column. Written atomically (matplotlib's Agg canvas)."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colors import LogNorm
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
 
     from .image import to_srgb8
 
-    panels = [*crops, ("reference", None, ref_crop)]
-    fig, axes = plt.subplots(1, len(panels), figsize=(2.2 * len(panels), 2.8), squeeze=False, layout="constrained")
-    for ax, (name, spp, img) in zip(axes[0], panels):
-        ax.imshow(to_srgb8(img), interpolation="nearest")
-        ax.set_title(name if spp is None else f"{name}\n{spp} spp", fontsize=9)
-        ax.axis("off")
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=100)
-    plt.close(fig)
+    x, y, w, h = crop
+    k = panels[0][2][3] if panels else 1
+    ref_full = _shrink(ref, k)
+    errs = np.concatenate([p[2][1].ravel() for p in panels]) if panels else np.ones(1)
+    pos = errs[errs > 0]
+    lo, hi = (float(np.percentile(pos, 1)), float(np.percentile(pos, 99.5))) if pos.size else (1e-6, 1.0)
+    norm = LogNorm(vmin=lo, vmax=max(hi, lo * 10))
+    cols = len(panels) + 1
+    fig = Figure(figsize=(2.4 * cols + 0.8, 7.4), dpi=100, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(3, cols, squeeze=False)
+    shown = None
+    for c, (name, spp, (full, err, crop_img, _)) in enumerate([*panels, ("reference", None, (ref_full, None,
+                                                                                              ref[y:y + h, x:x + w], k))]):
+        top, mid, bottom = axes[0][c], axes[1][c], axes[2][c]
+        top.imshow(to_srgb8(full), interpolation="nearest")
+        top.add_patch(Rectangle((x / k - 0.5, y / k - 0.5), w / k, h / k, fill=False, ec="yellow", lw=1))
+        top.set_title(name if spp is None else f"{name}, {spp} spp", fontsize=9)
+        mid.imshow(to_srgb8(crop_img), interpolation="nearest")
+        if err is not None:
+            shown = bottom.imshow(np.maximum(err, lo), norm=norm, cmap="magma", interpolation="nearest")
+        for ax in (top, mid, bottom):
+            ax.set_xticks([])
+            ax.set_yticks([])
+        if err is None:
+            bottom.axis("off")
+    axes[0][0].set_ylabel("image", fontsize=9)
+    axes[1][0].set_ylabel(f"crop {w} x {h} at ({x}, {y})", fontsize=9)
+    axes[2][0].set_ylabel("relative squared error", fontsize=9)
+    if shown is not None:
+        fig.colorbar(shown, ax=axes[2, :].tolist(), shrink=0.9, label="(I - R)^2 / (R^2 + 0.01)")
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fig.savefig(fh, format="png")
 
 
 def cmd_reference(args) -> int:

@@ -438,3 +438,19 @@ def test_the_first_render_says_it_is_compiling_and_its_bar_starts_after(tmp_path
     assert second.returncode == 0, second.stderr
     assert "compiling the renderer" not in second.stderr
     assert "px" in second.stderr  # the bar itself is still shown
+
+
+def test_compare_figure_panels_hold_the_error_map():
+    """The figure's error map is the relMSE's own per-pixel terms, averaged over channels; images over
+    FIGURE_SIDE are block-averaged for the figure, the crop stays at full resolution."""
+    rng = np.random.default_rng(4)
+    ref = rng.random((10, 14, 3)).astype(np.float32)
+    img = (ref + rng.normal(0, 0.1, ref.shape)).astype(np.float32)
+    full, err, crop, k = commands.figure_panels(img, ref, (2, 3, 5, 4))
+    assert k == 1 and full.shape == img.shape and crop.shape == (4, 5, 3)
+    want = ((img.astype(np.float64) - ref) ** 2 / (ref.astype(np.float64) ** 2 + 1e-2)).mean(axis=2)
+    np.testing.assert_allclose(err, want, rtol=1e-12)
+    assert float(err.mean()) == pytest.approx(rel_mse(img, ref), rel=1e-6)
+    big = np.ones((commands.FIGURE_SIDE * 2 + 1, 10, 3), np.float32)
+    full, err, crop, k = commands.figure_panels(big, big, (0, 0, 4, 4))
+    assert k == 3 and full.shape == ((2 * commands.FIGURE_SIDE + 1) // 3, 10 // 3, 3) and crop.shape == (4, 4, 3)
