@@ -9,6 +9,8 @@
 ``pyoa study``    error against spp over seeds, with confidence intervals
 (render, compare, reference and study run on a Dask cluster with
 ``--workers N`` or ``--scheduler ADDRESS``; in-process by default)
+
+One convention for every command (:data:`CONVENTION`, printed by ``pyoa --help``).
 """
 
 from __future__ import annotations
@@ -28,6 +30,43 @@ from .catalogue import get
 from .catalogue_types import MAX_UINT32, SppChoice, check_int
 from .cluster import TasksLost
 from .samplers import ENV_MAX_BYTES, trial_options
+
+#: The samples per pixel of every command that is given no ``--spp`` (``pyoa reference`` aside).
+DEFAULT_SPP = 121  # pyoa.render.commands.DEFAULT_SPP is the same (a test checks)
+#: How the commands name a sampler and take ``--spp`` and ``--dims`` (``pyoa --help`` prints it).
+CONVENTION = f"""\
+conventions, the same in every command:
+  sampler   a command about one sampler's points names it first: pyoa points bose, plot bose,
+            spectrum bose, spp bose; a command about a scene names the scene first and the sampler
+            with --sampler (render, reference) or --samplers A,B,... (compare, study). pbrt and
+            Mitsuba names (independent, stratified, orthogonal, ...) are accepted.
+  --spp     samples per pixel; default {DEFAULT_SPP} (the paper's count), reference 4096. Without --spp a
+            sampler that cannot have {DEFAULT_SPP} takes its nearest valid count and says so; a --spp you
+            give is refused with the nearest valid counts, except by compare and study, which take
+            each sampler's nearest and show it in their tables.
+  --dims    always a number of dimensions; spectrum's pair of dimensions is --pair I,J.
+  --size    W H of a render; compare takes the reference's size when --size is not given.
+Old spellings (points --sampler X, spectrum --dims I,J) still work in this release, with a note."""
+
+
+def deprecated(command: str, old: str, new: str) -> None:
+    """One line on stderr: ``old`` still works in this release; write ``new``."""
+    print(f"pyoa {command}: note: {old} is deprecated and goes in the next release; write {new}", file=sys.stderr)
+
+
+def resolve_spp(args, name: str, default: int = DEFAULT_SPP) -> int:
+    """``--spp`` as given, or without it the sampler's valid count nearest ``default`` (said on stderr when
+    it is not ``default``, unless ``-q``)."""
+    if args.spp is not None:
+        return args.spp
+    from .catalogue import nearest_spp
+
+    spp = nearest_spp(name, default, dims=getattr(args, "dims", None) if isinstance(getattr(args, "dims", None), int)
+                      else None, strength=getattr(args, "strength", None))
+    if spp != default and not getattr(args, "quiet", False):
+        print(f"pyoa {args.command}: {get(name).name} has no {default}-sample set; using its nearest valid count, "
+              f"{spp} (give --spp to choose)", file=sys.stderr)
+    return spp
 from .units import format_rate
 
 FORMATS = (".npy", ".csv")
@@ -92,7 +131,20 @@ def _pixel_range(args) -> range:
     return range(pixel0, pixel0 + count)
 
 
+def _sampler_arg(args, default: str = "bose") -> str:
+    """The sampler of ``pyoa points``: positional, or the old ``--sampler`` (with a note), else ``default``."""
+    if args.sampler is not None and args.sampler_option is not None and args.sampler != args.sampler_option:
+        raise ValueError(f"two samplers given: {args.sampler!r} and --sampler {args.sampler_option!r}; give one, "
+                         f"first: pyoa points {args.sampler} ...")
+    if args.sampler is None and args.sampler_option is not None:
+        deprecated("points", f"--sampler {args.sampler_option}", f"pyoa points {args.sampler_option} ...")
+        return args.sampler_option
+    return args.sampler or default
+
+
 def cmd_points(args) -> int:
+    args.sampler = _sampler_arg(args)
+    args.spp = resolve_spp(args, args.sampler)
     pixels = _pixel_range(args)
     check_out(args.out, FORMATS)
     options = {"offset": args.offset, "jitter": args.jitter, "strength": args.strength, "backend": args.backend,
@@ -172,6 +224,7 @@ def _options(args) -> dict:
 def cmd_plot(args) -> int:
     from .plots import projections
 
+    args.spp = resolve_spp(args, args.sampler)
     projections(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, pixel=args.pixel, out=args.out,
                 size=args.size, **_options(args))
     if not args.quiet:
@@ -182,10 +235,16 @@ def cmd_plot(args) -> int:
 def cmd_spectrum(args) -> int:
     from .plots import spectrum
 
+    if args.dims is not None and args.pair is not None:
+        raise ValueError("give the pair of dimensions once, as --pair I,J (--dims is its old spelling)")
+    if args.dims is not None:
+        deprecated("spectrum", f"--dims {args.dims}", f"--pair {args.dims} (--dims is a count in every command)")
+    pair = args.pair or args.dims or "0,1"
     try:
-        i, j = (int(v) for v in args.dims.split(","))
+        i, j = (int(v) for v in pair.split(","))
     except ValueError:
-        raise ValueError(f"--dims must be two dimensions i,j such as 0,1; got {args.dims!r}") from None
+        raise ValueError(f"--pair must be two dimensions I,J such as 0,1; got {pair!r}") from None
+    args.spp = resolve_spp(args, args.sampler)
     _, radii, mean = spectrum(args.sampler, spp=args.spp, dims=(i, j), trials=args.trials, seed=args.seed,
                               freq=args.freq, out=args.out, size=args.size, **_options(args))
     if not args.quiet:
@@ -217,12 +276,15 @@ def cmd_backends(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="pyoa", description="Orthogonal-array sampling for Monte Carlo rendering.")
+    ap = argparse.ArgumentParser(prog="pyoa", description="Orthogonal-array sampling for Monte Carlo rendering.",
+                                 epilog=CONVENTION, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="command", required=True)
 
+    spp_help = (f"samples per pixel (default {DEFAULT_SPP}, or the sampler's valid count nearest it)")
     p = sub.add_parser("points", help="generate a point set and save it (.npy or .csv)")
-    p.add_argument("--sampler", default="bose", help="sampler name (see `pyoa samplers`; default bose)")
-    p.add_argument("--spp", type=int, default=121, help="samples per pixel (default 121)")
+    p.add_argument("sampler", nargs="?", default=None, help="sampler name (see `pyoa samplers`; default bose)")
+    p.add_argument("--sampler", dest="sampler_option", default=None, help=argparse.SUPPRESS)  # the old spelling
+    p.add_argument("--spp", type=int, default=None, help=spp_help)
     p.add_argument("--dims", type=int, default=8, help="dimensions (default 8)")
     p.add_argument("--pixels", type=int, default=1, help="number of pixels (default 1)")
     p.add_argument("--pixel0", type=int, default=0, help="first pixel index (default 0)")
@@ -262,7 +324,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     def figure_options(p, out):
         p.add_argument("sampler", help="sampler name (see `pyoa samplers`)")
-        p.add_argument("--spp", type=int, default=121, help="samples per pixel (default 121)")
+        p.add_argument("--spp", type=int, default=None, help=spp_help)
         p.add_argument("--seed", type=int, default=0, help="user seed (default 0)")
         p.add_argument("--offset", choices=OFFSETS, default=None, help="offset style of OA samplers")
         p.add_argument("--jitter", type=float, default=None, help="jitter amount in [0, 1]")
@@ -281,7 +343,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("spectrum", help="expected power spectrum of a 2D projection (PNG)")
     figure_options(p, "spectrum.png")
-    p.add_argument("--dims", default="0,1", help="the two dimensions i,j (default 0,1)")
+    p.add_argument("--pair", default=None, help="the two dimensions I,J of the projection (default 0,1)")
+    p.add_argument("--dims", default=None, help=argparse.SUPPRESS)  # the old spelling of --pair
     p.add_argument("--trials", type=int, default=64, help="randomizations averaged (default 64)")
     p.add_argument("--freq", type=int, default=48, help="largest integer frequency shown (default 48)")
     p.set_defaults(func=cmd_spectrum)

@@ -1068,7 +1068,7 @@ def test_value_equals_generate_and_repr(backend, name, spp, grid_text):
                                               ("sobol", 32, [])])
 def test_cli_points(tmp_path, capsys, name, spp, extra):
     out = tmp_path / "x.npy"
-    args = ["points", "--sampler", name, "--spp", spp, "--dims", 5, "--pixels", 3, "--pixel0", 7,
+    args = ["points", name, "--spp", spp, "--dims", 5, "--pixels", 3, "--pixel0", 7,
             "--seed", 42, "--backend", "numpy", "--out", out, *extra]
     code, stdout, err = run_cli(args, capsys)
     assert code == 0, err
@@ -1079,10 +1079,10 @@ def test_cli_points(tmp_path, capsys, name, spp, extra):
 
 
 def test_cli_points_refuses_offset_for_baselines(tmp_path, capsys):
-    code, _, err = run_cli(["points", "--sampler", "sobol", "--spp", 16, "--offset", "mj", "--out",
+    code, _, err = run_cli(["points", "sobol", "--spp", 16, "--offset", "mj", "--out",
                             tmp_path / "x.npy"], capsys)
     assert code == 2 and "offset" in err
-    code, _, err = run_cli(["points", "--sampler", "sobol", "--spp", 100, "--out", tmp_path / "x.npy"], capsys)
+    code, _, err = run_cli(["points", "sobol", "--spp", 100, "--out", tmp_path / "x.npy"], capsys)
     assert code == 2 and "64" in err and "128" in err
     assert not (tmp_path / "x.npy").exists()
 

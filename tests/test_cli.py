@@ -20,7 +20,7 @@ def leftovers(folder, name):
     return [p for p in os.listdir(folder) if p != name and name in p]
 
 
-POINTS = ["points", "--sampler", "cmjnd", "--spp", "125", "--strength", "3", "--dims", "7", "--pixels", "3",
+POINTS = ["points", "cmjnd", "--spp", "125", "--strength", "3", "--dims", "7", "--pixels", "3",
           "--pixel0", "4294967293", "--seed", "11", "--offset", "mj", "--jitter", "0.75", "-q"]
 
 
@@ -224,7 +224,7 @@ def test_unusable_explicit_backend_exits_2(tmp_path, capsys, monkeypatch):
 
 def test_points_bush_equals_api(tmp_path, capsys, backend):
     out = tmp_path / "b.npy"
-    code, _, _ = run_cli(["points", "--sampler", "bush", "--spp", "64", "--strength", "3", "--dims", "11",
+    code, _, _ = run_cli(["points", "bush", "--spp", "64", "--strength", "3", "--dims", "11",
                           "--pixels", "2", "--seed", "4", "--backend", backend, "--out", out, "-q"], capsys)
     assert code == 0
     want = pyoa.sampler("bush", spp=64, strength=3, dims=11, seed=4, backend=backend).generate(pixels=range(2))
@@ -238,7 +238,7 @@ def test_cli_bush_and_gf_bose_listing_and_errors(tmp_path, capsys):
     assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == [["16777216", "8", "8", "9"]]
     code, out, _ = run_cli(["spp", "bose", "--near", "70"], capsys)
     assert code == 0 and [ln.split()[:2] for ln in out.strip().splitlines()[1:]] == [["64", "8"], ["81", "9"]]
-    code, _, err = run_cli(["points", "--sampler", "bush", "--spp", "8", "--strength", "3", "--dims", "4",
+    code, _, err = run_cli(["points", "bush", "--spp", "8", "--strength", "3", "--dims", "4",
                             "--out", tmp_path / "x.npy"], capsys)
     assert code == 2 and "27 (s=3, t=3)" in err and "64 (s=4, t=3)" in err
     assert not (tmp_path / "x.npy").exists()
@@ -252,7 +252,7 @@ def test_points_index2_equals_api(tmp_path, capsys, backend, name, spp, dims, of
     .npy is the API's array bit for bit, dimensions past the block included; the
     CSV round-trips to the same bits."""
     out = tmp_path / "x.npy"
-    args = ["points", "--sampler", name, "--spp", spp, "--dims", dims, "--pixels", "3", "--pixel0", "4294967293",
+    args = ["points", name, "--spp", spp, "--dims", dims, "--pixels", "3", "--pixel0", "4294967293",
             "--seed", "4294967295", "--offset", offset, "--jitter", "0.75", "--backend", backend]
     code, stdout, _ = run_cli(args + ["--out", out, "-q"], capsys)
     assert code == 0 and stdout == ""
@@ -280,15 +280,69 @@ def test_cli_index2_listing_and_errors(tmp_path, capsys):
                                                                                    ["98", "7", "2", "15"]]
     code, out, _ = run_cli(["spp", "addelman-kempthorne", "--limit", "3"], capsys)
     assert code == 0 and "18 " in out and "... 423 more" in out
-    code, _, err = run_cli(["points", "--sampler", "addelman-kempthorne", "--spp", "32", "--out", tmp_path / "x.npy"],
+    code, _, err = run_cli(["points", "addelman-kempthorne", "--spp", "32", "--out", tmp_path / "x.npy"],
                            capsys)
     # with the default 8 dims, 32 = 2^5 is a cmjnd count too
     assert code == 2 and "18 (s=3)" in err and "50 (s=5)" in err
     assert "32 is valid for cmjnd (s=2, t=5), bose-bush (s=4)" in err
     assert "Traceback" not in err
-    code, _, err = run_cli(["points", "--sampler", "bose-bush", "--spp", "18", "--out", tmp_path / "x.npy"], capsys)
+    code, _, err = run_cli(["points", "bose-bush", "--spp", "18", "--out", tmp_path / "x.npy"], capsys)
     assert code == 2 and "8 (s=2)" in err and "valid for addelman-kempthorne (s=3)" in err
-    code, _, err = run_cli(["points", "--sampler", "bose-bush", "--spp", "32", "--strength", "3",
+    code, _, err = run_cli(["points", "bose-bush", "--spp", "32", "--strength", "3",
                             "--out", tmp_path / "x.npy"], capsys)
     assert code == 2 and "strength 2 only" in err
     assert os.listdir(tmp_path) == []
+
+
+# -- one convention for every command (pyoa --help) ---------------------------------------------------
+
+
+def test_help_states_the_convention(capsys):
+    code, out, _ = run_cli(["--help"], capsys)
+    assert code == 0
+    assert "conventions, the same in every command:" in out and "--pair I,J" in out
+
+
+def test_points_names_its_sampler_first_and_keeps_the_old_spelling(tmp_path, capsys):
+    new, old = tmp_path / "new.npy", tmp_path / "old.npy"
+    code, _, err = run_cli(["points", "halton", "--spp", "10", "--out", new, "-q"], capsys)
+    assert code == 0 and err == ""
+    code, _, err = run_cli(["points", "--sampler", "halton", "--spp", "10", "--out", old, "-q"], capsys)
+    assert code == 0 and "note: --sampler halton is deprecated" in err and "write pyoa points halton" in err
+    np.testing.assert_array_equal(np.load(new), np.load(old))
+    code, _, err = run_cli(["points", "halton", "--sampler", "sobol", "--out", old, "-q"], capsys)
+    assert code == 2 and "two samplers given" in err
+
+
+def test_without_spp_a_sampler_takes_its_count_nearest_121_and_says_so(tmp_path, capsys):
+    out = tmp_path / "p.npy"
+    code, _, err = run_cli(["points", "sobol", "--dims", "2", "--out", out], capsys)
+    assert code == 0 and np.load(out).shape == (1, 128, 2)
+    assert "sobol has no 121-sample set; using its nearest valid count, 128" in err
+    code, _, err = run_cli(["points", "bose", "--dims", "2", "--out", out, "-q"], capsys)
+    assert code == 0 and np.load(out).shape == (1, 121, 2) and err == ""
+    code, _, err = run_cli(["plot", "sobol", "--dims", "3", "--out", tmp_path / "a.png", "-q"], capsys)
+    assert code == 0 and (tmp_path / "a.png").is_file()
+    # a count given is exact: refused with the nearest valid ones, never replaced
+    code, _, err = run_cli(["points", "sobol", "--spp", "121", "--out", out], capsys)
+    assert code == 2 and "nearest: 64" in err and "128" in err
+
+
+def test_spectrum_takes_its_pair_as_pair_and_the_old_dims_with_a_note(tmp_path, capsys):
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    code, out_new, err = run_cli(["spectrum", "jittered2d", "--spp", "16", "--pair", "0,2", "--trials", "2",
+                                  "--out", a], capsys)
+    assert code == 0 and err == "" and "dims 0,2" in out_new
+    code, out_old, err = run_cli(["spectrum", "jittered2d", "--spp", "16", "--dims", "0,2", "--trials", "2",
+                                  "--out", b], capsys)
+    assert code == 0 and "note: --dims 0,2 is deprecated" in err and "write --pair 0,2" in err
+    assert out_old.replace(str(b), "") == out_new.replace(str(a), "")
+    code, _, err = run_cli(["spectrum", "jittered2d", "--pair", "0,1", "--dims", "0,2", "--out", a], capsys)
+    assert code == 2 and "give the pair of dimensions once" in err
+
+
+def test_render_and_the_points_commands_share_the_default_spp():
+    from pyoa import cli
+    from pyoa.render import commands
+
+    assert cli.DEFAULT_SPP == commands.DEFAULT_SPP == 121

@@ -598,21 +598,21 @@ def test_qmc_engine_takes_a_base():
 
 def test_cli_points_with_a_base(tmp_path, capsys, backend):
     out = tmp_path / "f.npy"
-    args = ["points", "--sampler", "faure", "--base", "5", "--spp", "30", "--dims", "7", "--pixels", "2",
+    args = ["points", "faure", "--base", "5", "--spp", "30", "--dims", "7", "--pixels", "2",
             "--pixel0", U32_MAX - 1, "--seed", "9", "--backend", backend, "--out", out, "-q"]
     code, stdout, _ = run_cli(args, capsys)
     assert code == 0 and stdout == ""
     want = faure(30, 7, base=5, seed=9, backend=backend).generate(pixels=range(U32_MAX - 1, U32_MAX + 1))
     assert_same_bits(np.load(out), want, "pyoa points --base 5")
-    code, stdout, _ = run_cli(args[:3] + args[5:], capsys)  # no --base: the default (5 = smallest prime >= 5)
+    code, stdout, _ = run_cli(args[:2] + args[4:], capsys)  # no --base: the default (5 = smallest prime >= 5)
     assert code == 0 and stdout == "" and np.load(out).shape == (2, 30, 7)
     assert_same_bits(np.load(out), faure(30, 7, seed=9).generate(pixels=range(U32_MAX - 1, U32_MAX + 1)),
                      "pyoa points, default base")
 
 
 @pytest.mark.parametrize("args, message", [
-    (["points", "--sampler", "bose", "--base", "5"], "pyoa points: error: bose takes no base (got base=5)"),
-    (["points", "--sampler", "faure", "--base", "6"], "faure: base must be a prime in [2, 4093], got 6; nearest: 5, 7"),
+    (["points", "bose", "--base", "5"], "pyoa points: error: bose takes no base (got base=5)"),
+    (["points", "faure", "--base", "6"], "faure: base must be a prime in [2, 4093], got 6; nearest: 5, 7"),
     (["spp", "sobol", "--base", "2"], "pyoa spp: error: sobol takes no base (got base=2)"),
     (["spp", "faure", "--base", "4096"], "got 4096; nearest: 4091, 4093"),
     (["plot", "bose", "--base", "3"], "pyoa plot: error: bose takes no base (got base=3)"),

@@ -66,7 +66,7 @@ POINTS_COUNTS = [
     (["--dims", "-4"], ["dims"]),
     (["--seed", "-1"], ["seed must be in [0, 4294967295]"]),
     (["--seed", "4294967296"], ["seed"]),
-    (["--sampler", "bush", "--spp", "64", "--strength", "0"], ["strength must be >= 1"]),
+    (["bush", "--spp", "64", "--strength", "0"], ["strength must be >= 1"]),
 ]
 
 
@@ -108,8 +108,8 @@ FIGURE_COUNTS = [
     ("spectrum", ["--trials", "-64"], ["trials"]),
     ("spectrum", ["--freq", "0"], ["freq must be in [4, 512], got 0"]),
     ("spectrum", ["--size", "0"], ["figure size"]),
-    ("spectrum", ["--dims", "0,-1"], ["dims must be >= 0"]),
-    ("spectrum", ["--dims", "1,1"], ["two different dimensions"]),
+    ("spectrum", ["--pair", "0,-1"], ["dims must be >= 0"]),
+    ("spectrum", ["--pair", "1,1"], ["two different dimensions"]),
 ]
 
 
@@ -186,7 +186,7 @@ def test_csv_written_in_blocks_equals_one_block(tmp_path, monkeypatch):
     is the same whatever the block size."""
     from pyoa import cli
 
-    args = ["points", "--sampler", "cmjnd", "--spp", "27", "--dims", "4", "--pixels", "7", "--pixel0", "5",
+    args = ["points", "cmjnd", "--spp", "27", "--dims", "4", "--pixels", "7", "--pixel0", "5",
             "--backend", "numpy", "-q", "--out"]
     assert cli.main(args + [str(tmp_path / "one.csv")]) == 0
     monkeypatch.setattr(cli, "CSV_BLOCK_VALUES", 2 * 27 * 6)  # two pixels per block

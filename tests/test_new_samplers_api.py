@@ -234,7 +234,7 @@ def test_convergence_runs_zsobol_on_trial_pixels():
 
 # --------------------------------------------------------------------------- pyoa points
 
-POINTS = ["points", "--sampler", "zsobol", "--spp", "16", "--dims", "4", "--seed", "5", "--backend", "numpy", "-q"]
+POINTS = ["points", "zsobol", "--spp", "16", "--dims", "4", "--seed", "5", "--backend", "numpy", "-q"]
 
 
 def test_cli_points_with_a_resolution(tmp_path, capsys):
@@ -263,7 +263,7 @@ def test_cli_points_past_the_image(tmp_path, capsys):
 
 def test_cli_points_resolution_refused_by_other_samplers(tmp_path, capsys):
     out = tmp_path / "p.npy"
-    code, _, err = run_cli(["points", "--sampler", "pmj02", "--spp", "16", "--resolution", "4", "3", "-q",
+    code, _, err = run_cli(["points", "pmj02", "--spp", "16", "--resolution", "4", "3", "-q",
                             "--backend", "numpy", "--out", out], capsys)
     assert code == 2 and "resolution" in err and err.count("\n") == 1, err
     assert not out.exists()

@@ -96,14 +96,14 @@ def test_cli_plot_and_spectrum(tmp_path, capsys):
                      "--backend", "numpy"]) == 0
     assert png_shape(out) == (120, 120)
     out = tmp_path / "spec.png"
-    assert cli.main(["spectrum", "jittered2d", "--spp", "49", "--dims", "2,3", "--trials", "8", "--freq", "8",
+    assert cli.main(["spectrum", "jittered2d", "--spp", "49", "--pair", "2,3", "--trials", "8", "--freq", "8",
                      "--size", "160", "--out", str(out), "--backend", "numpy"]) == 0
     assert png_shape(out) == (80, 160)
     assert "low-frequency power" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["spectrum", "bose", "--dims", "0"], ["--dims", "i,j"]),
+    (["spectrum", "bose", "--pair", "0"], ["--pair", "I,J"]),
     (["plot", "bose", "--spp", "120"], ["120", "121"]),
     (["plot", "sobol", "--offset", "mj"], ["offset"]),
 ])

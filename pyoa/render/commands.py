@@ -35,6 +35,8 @@ from .scene import load
 from .state import check_state_file
 from .tiles import render_on
 
+#: --spp of render and compare without one (``pyoa.cli.DEFAULT_SPP``; the CLI's convention).
+DEFAULT_SPP = 121
 #: Bytes per pixel that a command allocates besides the render, bounded: the
 #: PNG's float64 sRGB conversion, the reference and the float64 copies of
 #: relMSE (``pyoa render``, ``pyoa compare``), the float64 running sum, its
@@ -82,6 +84,9 @@ def _plan(scene, args, sampler: str, spp: int, seed: int | None = None, base: in
 
 
 def cmd_render(args) -> int:
+    from ..cli import resolve_spp
+
+    args.spp = resolve_spp(args, args.sampler)
     _check_counts(args)
     if args.crop and not args.reference:
         raise ValueError("--crop needs --reference: it is the window of the relative MSE against it")
@@ -194,6 +199,10 @@ def cmd_compare(args) -> int:
     _check_counts(args)
     seeds = check_seeds(args.seed, args.seeds)
     md_path, csv_path, png_path = _compare_outputs(args.out)
+    if args.size is None:  # the reference fixes the size: it need not be repeated
+        from .image import image_info
+
+        args.size = list(image_info(args.reference)[:2])
     scene = load(args.scene)
     jobs = []
     for name in names:  # every sampler's render is checked before the first one starts
@@ -468,9 +477,9 @@ def reference_interrupted(args) -> str:
 def add_parsers(sub) -> None:
     """Add ``render``, ``compare`` and ``reference`` to the ``pyoa`` command line."""
 
-    def common(p, spp):
+    def common(p, spp, spp_help=None):
         p.add_argument("scene", help="a bundled scene name (cornell, dof7d, bounce9d, deep) or a .json file")
-        p.add_argument("--spp", type=int, default=spp, help=f"samples per pixel (default {spp})")
+        p.add_argument("--spp", type=int, default=spp, help=spp_help or f"samples per pixel (default {spp})")
         p.add_argument("--seed", type=int, default=0, help="sampler seed (default 0)")
         p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None,
                        help="image size (default: the scene's)")
@@ -487,7 +496,7 @@ def add_parsers(sub) -> None:
         add_engine_arguments(p)
 
     p = sub.add_parser("render", help="render a scene with one sampler (EXR, optional PNG)")
-    common(p, 16)
+    common(p, None, f"samples per pixel (default {DEFAULT_SPP}, or the sampler's valid count nearest it)")
     p.add_argument("--sampler", default="bose", help="sampler name (default bose)")
     p.add_argument("--base", type=int, default=None,
                    help="faure's prime digit base (default: chosen from --spp and the scene's dimensions)")
@@ -507,10 +516,12 @@ def add_parsers(sub) -> None:
     p.set_defaults(func=cmd_render, interrupted=render_interrupted)
 
     p = sub.add_parser("compare", help="render with several samplers and tabulate relMSE against a reference")
-    common(p, 121)
+    common(p, DEFAULT_SPP, f"samples per pixel (default {DEFAULT_SPP}); each sampler renders its valid count "
+                           "nearest it, shown in the table")
     p.add_argument("--samplers", default=",".join(["bose", *catalogue.names("baseline")]),
                    help="comma-separated sampler names (default: bose and every comparison sampler)")
-    p.add_argument("--reference", required=True, help="reference EXR (pyoa reference SCENE)")
+    p.add_argument("--reference", required=True, help="reference EXR (pyoa reference SCENE); its size is the "
+                                                      "render's unless --size is given")
     p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
                    help="crop window (default: the quarter-size window at (W/4, H/4))")
     p.add_argument("--seeds", type=int, default=1, metavar="N",

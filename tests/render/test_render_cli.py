@@ -454,3 +454,22 @@ def test_compare_figure_panels_hold_the_error_map():
     big = np.ones((commands.FIGURE_SIDE * 2 + 1, 10, 3), np.float32)
     full, err, crop, k = commands.figure_panels(big, big, (0, 0, 4, 4))
     assert k == 3 and full.shape == ((2 * commands.FIGURE_SIDE + 1) // 3, 10 // 3, 3) and crop.shape == (4, 4, 3)
+
+
+def test_compare_takes_the_reference_size_and_render_defaults_to_121(tmp_path, capsys, reference16):
+    stem = tmp_path / "cmp"
+    assert main(["compare", "cornell", "--spp", "4", "--samplers", "bose", "--reference", str(reference16),
+                 "--out", str(stem), "-q"]) == 0  # no --size: the 16 x 16 reference's
+    capsys.readouterr()
+    with open(f"{stem}.csv", newline="") as fh:
+        row = next(csv.DictReader(fh))
+    img = render(load("cornell"), sampler="bose", spp=4, seed=0, width=16, height=16).image
+    assert float(row["relmse"]) == pytest.approx(rel_mse(img, read_image(reference16)), rel=1e-9)
+    from pyoa.render import provenance
+
+    out = tmp_path / "r.exr"
+    assert main(["render", "dof7d", "--size", "8", "8", "--out", str(out), "-q"]) == 0
+    assert provenance.read(out)["spp"] == 121
+    assert main(["render", "dof7d", "--size", "8", "8", "--sampler", "sobol", "--out", str(out)]) == 0
+    assert provenance.read(out)["spp"] == 128
+    assert "sobol has no 121-sample set; using its nearest valid count, 128" in capsys.readouterr().err
