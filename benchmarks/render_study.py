@@ -39,12 +39,24 @@ from pyoa.study import PADDED, cells, read_rows  # noqa: E402
 
 RESULTS_MD = REPO / "docs" / "results.md"
 BEGIN, END = "<!-- render-study:begin -->", "<!-- render-study:end -->"
+#: What each scene exercises; its dimension count and path length are read from the renderer's own
+#: layout (dimensions), never written here, so the page cannot drift from what `pyoa render` prints.
 SCENES = {
-    "dof7d": "7 dimensions: pixel, lens, time, light (direct lighting, depth of field, motion blur)",
-    "bounce9d": "9 dimensions: one bounce of indirect light",
-    "deep": "46 dimensions: up to 11 bounces, glossy and mirror surfaces",
-    "cornell": "Mitsuba's Cornell box, path depth 5 (23 dimensions)",
+    "dof7d": "pixel, lens, time, light (direct lighting, depth of field, motion blur)",
+    "bounce9d": "one bounce of indirect light",
+    "deep": "glossy and mirror surfaces, long paths",
+    "cornell": "Mitsuba's Cornell box",
 }
+
+
+def about(scene: str) -> str:
+    """``SCENES[scene]`` with the dimensions and longest path of the scene's layout (as ``pyoa render``
+    prints them)."""
+    from pyoa.render.render import plan
+    from pyoa.render.scene import load
+
+    layout = plan(load(scene), sampler="random", spp=1, width=1, height=1).layout
+    return f"{layout.dims} dimensions, paths of up to {layout.max_depth} segments; {SCENES[scene]}"
 
 
 def verdicts(table: dict) -> list[str]:
@@ -121,8 +133,9 @@ def section(out: Path, meta: dict) -> str:
     body = md.split("\n", 2)[2] if md.startswith("# ") else md  # drop the study's own title
     # the study's per-scene headings become this page's subsections
     body = body.replace("\n## ", "\n### ")
-    for scene, about in SCENES.items():
-        body = body.replace(f"### {scene}\n", f"### `{scene}`: {about}\n\n![{scene}]({rel}/study-{scene}.png)\n", 1)
+    for scene in SCENES:
+        body = body.replace(f"### {scene}\n", f"### `{scene}`: {about(scene)}\n\n![{scene}]({rel}/study-{scene}.png)\n",
+                            1)
     table = cells(rows, noise)
     lines = [BEGIN, "## Renders", "",
              f"`pyoa study` (`benchmarks/render_study.py`): {meta['what']} Rows: `{rel}/study.csv` (one per "
