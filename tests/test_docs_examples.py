@@ -114,3 +114,21 @@ def test_quoted_error_messages_are_pyoas_own(tmp_path):
         load(bad)
     quoted = "cornell.json: shapes[3].material: unknown material 'whte'; valid: white, red, green"
     assert str(exc.value).endswith(quoted[len("cornell.json"):]) and quoted in _flat(ROOT / "docs" / "rendering.md")
+
+
+def test_every_relative_link_stays_in_the_repository():
+    """The docs link only to files of this repository (a user's clone has nothing beside it), and every
+    such link names a file or folder that exists; web links are left to the reader."""
+    import re
+
+    files = [*FILES, *sorted((ROOT / "benchmarks").glob("*.md")), *sorted((ROOT / "scenes").glob("*.md"))]
+    bad = []
+    for path in files:
+        text = path.read_text()
+        for target in re.findall(r"\]\(([^)\s]+)\)", text) + re.findall(r"^\[[^\]]+\]:\s*(\S+)", text, re.M):
+            if re.match(r"[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
+                continue  # a URL (https:, mailto:) or an anchor in the same file
+            where = (path.parent / target.split("#")[0]).resolve()
+            if not where.is_relative_to(ROOT) or not where.exists():
+                bad.append(f"{path.relative_to(ROOT)}: {target}")
+    assert not bad, "links outside the repository or to nothing:\n" + "\n".join(bad)
