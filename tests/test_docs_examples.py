@@ -132,3 +132,11 @@ def test_every_relative_link_stays_in_the_repository():
             if not where.is_relative_to(ROOT) or not where.exists():
                 bad.append(f"{path.relative_to(ROOT)}: {target}")
     assert not bad, "links outside the repository or to nothing:\n" + "\n".join(bad)
+
+
+def test_the_docs_list_the_padded_samplers_the_study_uses():
+    """docs/distributed.md names the samplers a study's headline calls "padded" (it once left zsobol out)."""
+    from pyoa.study import PADDED
+
+    text = _flat(ROOT / "docs" / "distributed.md")
+    assert "(of " + ", ".join(f"`{n}`" for n in PADDED) + ", the one with the lowest mean)" in text
