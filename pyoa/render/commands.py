@@ -144,8 +144,14 @@ def cmd_render(args) -> int:
             h, w = res.image.shape[:2]
             print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
             where = "" if eng.client is None else f" on {eng.description}"
-            print(f"{res.seconds:.2f} s{where}, {format_rate(res.paths_per_second)}paths/s, "
-                  f"{format_rate(res.rays_per_second)}rays/s -> {args.out}{' and ' + args.png if args.png else ''}")
+            if res.compiled is None:
+                speed = f"{format_rate(res.paths_per_second)}paths/s, {format_rate(res.rays_per_second)}rays/s"
+            elif res.stats.paths > res.compiled[1]:  # the first render after an install: its rate without the compile
+                speed = (f"{res.compiled[0]:.1f} s of it compiling the renderer (once), "
+                         f"{format_rate(res.steady_paths_per_second())}paths/s after")
+            else:  # one batch: no rate to give apart from the compile
+                speed = "most of it compiling the renderer (once; the next render is quicker)"
+            print(f"{res.seconds:.2f} s{where}, {speed} -> {args.out}{' and ' + args.png if args.png else ''}")
     if ref is not None:
         print(relmse_line(image, ref, args.crop, noise, args.reference))
     return 0

@@ -75,6 +75,9 @@ class RenderResult:
     shading: str = "numba"
     #: seconds per stage summed over the worker threads (compiled shading only)
     timings: dict = field(default_factory=dict)
+    #: (seconds, paths) of the first batch when it compiled the renderer (numba's cache was empty; only
+    #: measured with a progress bar); part of ``seconds``, which :meth:`steady_paths_per_second` leaves out
+    compiled: tuple | None = None
     #: (integrator, shading) that rendered it, for a later render of the same
     #: scene and settings to reuse (``render(..., integrator=)``)
     integrator: tuple | None = field(default=None, repr=False, compare=False)
@@ -86,6 +89,12 @@ class RenderResult:
     @property
     def rays_per_second(self) -> float:
         return self.stats.rays / max(self.seconds, 1e-9)
+
+    def steady_paths_per_second(self) -> float:
+        """Paths per second without the batch that compiled the renderer (all of them when none did)."""
+        if self.compiled is None:
+            return self.paths_per_second
+        return (self.stats.paths - self.compiled[1]) / max(self.seconds - self.compiled[0], 1e-9)
 
 
 def _count(name: str, value, default: int | None = None, hi: int | None = None) -> int:
@@ -358,17 +367,21 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         return st
 
     bar = None
+    compiled = None
     t0 = time.perf_counter()
     outer = progress if hasattr(progress, "update") else None
     if progress:
         # The first batch runs before the bar starts: it pays the one-time costs (numba compiling the
         # renderer after an install, the sampler's OpenCL build, Embree's scene), which would otherwise
         # freeze the bar at its first step with an ETA of minutes. Said when it is the long one.
-        if getattr(integ, "needs_compiling", lambda: False)():
+        compiling = getattr(integ, "needs_compiling", lambda: False)()
+        if compiling:
             print("compiling the renderer with numba (once per installed version of pyoa, 15-60 s) ...",
                   file=sys.stderr, flush=True)
         (p0, p1), batches = batches[0], batches[1:]
         total.add(run((p0, p1)))
+        if compiling:
+            compiled = (time.perf_counter() - t0, (p1 - p0) * n)
         if outer is not None:
             outer.update(n * (p1 - p0) / (width * height))
         else:
@@ -391,4 +404,4 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     seconds = time.perf_counter() - t0
     return RenderResult(image=out.reshape(shape), sampler=smp.name, spp=n, seed=seed,
                         dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total, shading=shading,
-                        timings=dict(getattr(integ, "timings", {})), integrator=integrator)
+                        timings=dict(getattr(integ, "timings", {})), integrator=integrator, compiled=compiled)

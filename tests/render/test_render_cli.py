@@ -427,13 +427,14 @@ def test_the_first_render_says_it_is_compiling_and_its_bar_starts_after(tmp_path
     import sys
 
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))  # an empty cache: a fresh install
-    cmd = [sys.executable, "-m", "pyoa", "render", "dof7d", "--size", "32", "32", "--spp", "4",
-           "--out", str(tmp_path / "a.exr")]
+    cmd = [sys.executable, "-m", "pyoa", "render", "dof7d", "--size", "128", "128", "--spp", "16",
+           "--out", str(tmp_path / "a.exr")]  # 4 batches: one compiles, three give the rate
     first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
     assert first.returncode == 0, first.stderr
     said = first.stderr.find("compiling the renderer with numba (once per installed version of pyoa")
     assert said >= 0, first.stderr
     assert "px" not in first.stderr[:said]  # no bar before the message
+    assert re.search(r"s of it compiling the renderer \(once\), [0-9.]+ [kM]?paths/s after", first.stdout), first.stdout
     second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
     assert second.returncode == 0, second.stderr
     assert "compiling the renderer" not in second.stderr
