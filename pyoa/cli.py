@@ -32,7 +32,7 @@ from .cluster import TasksLost
 from .samplers import ENV_MAX_BYTES, trial_options
 
 #: The samples per pixel of every command that is given no ``--spp`` (``pyoa reference`` aside).
-DEFAULT_SPP = 121  # pyoa.render.commands.DEFAULT_SPP is the same (a test checks)
+DEFAULT_SPP = 121
 #: How the commands name a sampler and take ``--spp`` and ``--dims`` (``pyoa --help`` prints it).
 CONVENTION = f"""\
 conventions, the same in every command:
@@ -61,8 +61,9 @@ def resolve_spp(args, name: str, default: int = DEFAULT_SPP) -> int:
         return args.spp
     from .catalogue import nearest_spp
 
-    spp = nearest_spp(name, default, dims=getattr(args, "dims", None) if isinstance(getattr(args, "dims", None), int)
-                      else None, strength=getattr(args, "strength", None))
+    dims = getattr(args, "dims", None)  # a count where the command has one (spectrum's old --dims is a pair)
+    spp = nearest_spp(name, default, dims=dims if isinstance(dims, int) else None,
+                      strength=getattr(args, "strength", None))
     if spp != default and not getattr(args, "quiet", False):
         print(f"pyoa {args.command}: {get(name).name} has no {default}-sample set; using its nearest valid count, "
               f"{spp} (give --spp to choose)", file=sys.stderr)

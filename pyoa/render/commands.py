@@ -11,6 +11,7 @@ from .. import catalogue
 from ..analysis.statistics import corrected, mean_ci, ratio_ci, relmse_noise
 from ..atomic import atomic_path
 from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
+from ..cli import DEFAULT_SPP, resolve_spp
 from ..cluster import add_arguments as add_engine_arguments
 from ..cluster import check_engine, engine
 from ..units import format_interval, format_rate, format_ratio
@@ -35,8 +36,6 @@ from .scene import load
 from .state import check_state_file
 from .tiles import render_on
 
-#: --spp of render and compare without one (``pyoa.cli.DEFAULT_SPP``; the CLI's convention).
-DEFAULT_SPP = 121
 #: Bytes per pixel that a command allocates besides the render, bounded: the
 #: PNG's float64 sRGB conversion, the reference and the float64 copies of
 #: relMSE (``pyoa render``, ``pyoa compare``), the float64 running sum, its
@@ -84,8 +83,6 @@ def _plan(scene, args, sampler: str, spp: int, seed: int | None = None, base: in
 
 
 def cmd_render(args) -> int:
-    from ..cli import resolve_spp
-
     args.spp = resolve_spp(args, args.sampler)
     _check_counts(args)
     if args.crop and not args.reference:

@@ -65,13 +65,18 @@ def test_render_non_square_size_and_options(tmp_path, capsys):
     np.testing.assert_array_equal(read_image(out), want)
 
 
+def _relmse_line(capsys, ref_path, out) -> str:
+    """What ``pyoa render --reference REF --crop 4 4 8 8`` (16 x 16, 4 spp) prints."""
+    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "-q",
+                 "--reference", str(ref_path), "--crop", "4", "4", "8", "8"]) == 0
+    return capsys.readouterr().out.strip()
+
+
 def test_render_reference_prints_relmse(tmp_path, capsys):
     ref_path, out = tmp_path / "ref.exr", tmp_path / "x.exr"
     ref = render(load("cornell"), sampler="sobol", spp=16, seed=9, width=16, height=16).image
     write_exr(ref_path, ref)
-    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "-q",
-                 "--reference", str(ref_path), "--crop", "4", "4", "8", "8"]) == 0
-    line = capsys.readouterr().out.strip()
+    line = _relmse_line(capsys, ref_path, out)
     m = re.fullmatch(r"relMSE (\S+), crop (\S+) \(the reference's own noise is unknown: no ref.variance.exr "
                      r"beside it, as `pyoa reference` writes\)", line)
     assert m, line
@@ -91,9 +96,7 @@ def test_render_reference_subtracts_the_reference_noise(tmp_path, capsys):
     ref_path, out = tmp_path / "ref.exr", tmp_path / "x.exr"
     assert main(["reference", "cornell", "--size", "16", "16", "--spp", "64", "--pass-spp", "16",
                  "--out", str(ref_path), "-q"]) == 0
-    assert main(["render", "cornell", "--size", "16", "16", "--spp", "4", "--out", str(out), "-q",
-                 "--reference", str(ref_path), "--crop", "4", "4", "8", "8"]) == 0
-    line = capsys.readouterr().out.strip()
+    line = _relmse_line(capsys, ref_path, out)
     m = re.fullmatch(r"relMSE (\S+), crop (\S+); less the reference's own noise \(an estimated (\S+), crop (\S+), "
                      r"from ref.variance.exr\): (\S+), crop (\S+)", line)
     assert m, line
