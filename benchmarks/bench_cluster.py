@@ -44,6 +44,7 @@ from common import REPO, machine, replace_section, write_text  # noqa: E402
 from pyoa import cluster  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 from pyoa.render.scene_source import source_of  # noqa: E402
+from pyoa.render.settings import RenderSettings  # noqa: E402
 from pyoa.render.tiles import render_on  # noqa: E402
 from pyoa.study import Job, study_task  # noqa: E402
 
@@ -61,7 +62,7 @@ def run_study(eng, scene, reference, jobs) -> tuple[float, list]:
 
     src = eng.share(scene if eng.client is None else source_of(scene))
     ref = eng.share(reference)
-    kw = dict(width=64, height=64, max_depth=None, filter="box", first=None, backend=None, shading="numba")
+    kw = RenderSettings(width=64, height=64, shading="numba")
     t0 = time.perf_counter()
     with closing(eng.run(study_task, [(src, ref, (16, 16, 16, 16), kw, j, eng.task_threads()) for j in jobs])) as r:
         rows = sorted((jobs[i].ident, row["relmse"]) for i, row in r)

@@ -522,12 +522,14 @@ class RowWriter:
 # -- tasks ---------------------------------------------------------------------------------------
 
 
-def study_task(scene, reference: np.ndarray, crop, kwargs: dict, job: Job, threads: int | None) -> dict:
-    """One render of a study and its errors against ``reference``: a CSV row."""
+def study_task(scene, reference: np.ndarray, crop, settings, job: Job, threads: int | None) -> dict:
+    """One render of a study (``settings``, a
+    :class:`~pyoa.render.settings.RenderSettings`, with the job's sampler,
+    count and seed) and its errors against ``reference``: a CSV row."""
     from .render.image import check_finite, rel_mse
     from .render.tiles import worker_render
 
-    res = worker_render(scene, dict(kwargs, sampler=job.sampler, spp=job.spp, seed=job.seed), threads=threads)
+    res = worker_render(scene, settings.replace(sampler=job.sampler, spp=job.spp, seed=job.seed), threads=threads)
     check_finite(res.image, f"the {job.sampler} render of {job.scene} ({job.spp} spp, seed {job.seed})")
     diff = res.image.astype(np.float64) - reference
     return dict(scene=job.scene, sampler=job.sampler, spp_asked=job.spp_asked, spp=job.spp, seed=job.seed,
@@ -786,9 +788,10 @@ def _read_own(path: Path, saved: dict, dims) -> np.ndarray | None:
     return pixels if is_reference(saved.get("reference"), path, pixels) else None
 
 
-def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[dict], dims, planned: dict,
-                    shading: str, pass_spp: int | None) -> dict:
-    """Every scene's :class:`ReferencePlan`, checked before any work.
+def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[dict], dims, rendering,
+                    pass_spp: int | None) -> dict:
+    """Every scene's :class:`ReferencePlan`, checked before any work
+    (``rendering``: the study's :class:`~pyoa.render.settings.RenderSettings`).
 
     A scene with rows keeps the reference they were measured against: a
     given image must have its pixels, and ``--reference-spp`` its settings
@@ -846,9 +849,9 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
         # a reference to render: every output it writes, checked now
         check_output(path, "the study's reference", EXR)
         check_output(variance_path(path), "the study's reference variance", EXR)
-        p = plan(scene, sampler="sobol", spp=pass_spp, seed=0, **planned)
+        p = plan(scene, rendering, sampler="sobol", spp=pass_spp, seed=0)
         _check_job_memory(p, f"a {name} reference pass of {pass_spp} spp")
-        key = reference_key(scene, p, pass_spp=pass_spp, passes=passes, seed=0, filter=args.filter, shading=shading)
+        key = reference_key(scene, p, pass_spp=pass_spp, passes=passes, seed=0)
         plans[name] = ReferencePlan(path, None, key, made_with)
     return plans
 
@@ -864,6 +867,7 @@ def run(args) -> int:
     from .render.render import plan, resolve_shading
     from .render.scene import load
     from .render.scene_source import source_of
+    from .render.settings import RenderSettings
     from .render.state import scene_digest
 
     t_start = time.perf_counter()
@@ -901,9 +905,9 @@ def run(args) -> int:
         rows = read_rows(out / "study.csv")
         shading = resolve_shading(args.shading)
         size = dict(width=args.size[0], height=args.size[1]) if args.size else dict(width=None, height=None)
-        # plan() takes every render setting but the shading
-        planned = dict(**size, max_depth=args.max_depth, filter=args.filter, first=None, backend=args.backend)
-        common = dict(planned, shading=shading)
+        # every render of the study, its references' passes included, with its sampler, count and seed
+        rendering = RenderSettings(**size, max_depth=args.max_depth, filter=args.filter, backend=args.backend,
+                                   shading=shading)
         # every check a long job could fail at its end, on the client, before any task
         loaded, jobs, dims = {}, [], None
         for sname in scenes_arg:
@@ -916,7 +920,7 @@ def run(args) -> int:
                     n = catalogue.nearest_spp(name, asked)
                     if n is None:
                         raise ValueError(f"{name} has no valid sample count near {asked}")
-                    p = plan(scene, sampler=name, spp=n, seed=seed0, **planned)
+                    p = plan(scene, rendering, sampler=name, spp=n, seed=seed0)
                     _check_job_memory(p, f"a {scene.name} render with {name} at {n} spp")
                     if dims is None:
                         dims, first = (p.width, p.height), scene.name
@@ -934,7 +938,7 @@ def run(args) -> int:
             if r["scene"] in loaded and settings["scenes"][r["scene"]].get("reference") is None:
                 raise ValueError(f"{out / 'study.csv'} holds {r['scene']} rows but study.json no reference for "
                                  "them; give another --out")
-        refs = plan_references(args, out, loaded, settings, rows, dims, planned, shading, pass_spp)
+        refs = plan_references(args, out, loaded, settings, rows, dims, rendering, pass_spp)
         # the variance files of the references at hand (a given one's too)
         noise = {n: reference_noise(r.path, r.pixels, crop) for n, r in refs.items() if r.pixels is not None}
         # every check made: now the rows the run appends to, as the catalogue spells them, once each
@@ -949,13 +953,13 @@ def run(args) -> int:
                     passes = ref.key["passes"]
                     if not args.quiet:
                         print(f"reference of {name}: {args.reference_spp} spp in {passes} passes on {where}")
-                    meta = describe(scene, plan(scene, sampler="sobol", spp=pass_spp, seed=0, **planned),
-                                    kind="reference", seed=0, filter=args.filter, shading=shading,
+                    one_pass = rendering.replace(sampler="sobol", spp=pass_spp, seed=0)
+                    meta = describe(scene, plan(scene, one_pass), kind="reference",
                                     command=command_line(args.argv) if hasattr(args, "argv") else None,
                                     passes=passes, pass_spp=pass_spp)
                     meta["spp"] = args.reference_spp
-                    render_reference(eng, scene, out=ref.path, key=ref.key, kwargs=dict(common, sampler="sobol",
-                                     spp=pass_spp), seed=0, quiet=args.quiet, command="pyoa study", metadata=meta)
+                    render_reference(eng, scene, out=ref.path, key=ref.key, settings=one_pass, seed=0,
+                                     quiet=args.quiet, command="pyoa study", metadata=meta)
                     ref.pixels = read_reference(ref.path, "the study's reference", *dims)
                     if any(r["scene"] == name for r in rows) and not is_reference(rec.get("reference"), ref.path,
                                                                                    ref.pixels):
@@ -981,8 +985,7 @@ def run(args) -> int:
             shared = {n: (eng.share(s if eng.client is None else source_of(s)), eng.share(images[n]))
                       for n, s in loaded.items()}
             threads = eng.task_threads()
-            kwargs = dict(common)
-            args_list = [(*shared[j.scene], crop, kwargs, j, threads) for j in todo]
+            args_list = [(*shared[j.scene], crop, rendering, j, threads) for j in todo]
             writer = RowWriter(out / "study.csv")
             try:
                 with closing(eng.run(study_task, args_list, key="pyoa-study")) as results:

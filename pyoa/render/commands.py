@@ -31,8 +31,9 @@ from .layout import MAX_DEPTH
 from .progressive import check_progressive, render_progressive, state_path
 from .provenance import command_line, describe
 from .reference import reference_key, reference_noise, render_reference, variance_path
-from .render import SHADINGS, check_memory, plan, resolve_shading
+from .render import SHADINGS, check_memory, plan
 from .scene import load
+from .settings import RenderSettings
 from .state import check_state_file
 from .tiles import render_on
 
@@ -77,9 +78,16 @@ def _check_job_memory(p, what: str) -> None:
     check_memory(p.nbytes + p.width * p.height * POST_PIXEL_BYTES, what, p.max_bytes)
 
 
+def _settings(args, sampler: str, spp: int, seed: int | None = None, base: int | None = None) -> RenderSettings:
+    """The render settings of a command's options (``--size``, ``--max-depth``, ``--filter``, ``--first``,
+    ``--backend``, ``--shading``) for ``sampler`` at ``spp`` (``seed``: ``--seed`` unless given)."""
+    return RenderSettings(sampler=sampler, spp=spp, seed=args.seed if seed is None else seed, **_size(args),
+                          max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
+                          shading=args.shading, base=base)
+
+
 def _plan(scene, args, sampler: str, spp: int, seed: int | None = None, base: int | None = None):
-    return plan(scene, sampler=sampler, spp=spp, seed=args.seed if seed is None else seed, **_size(args),
-                max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend, base=base)
+    return plan(scene, _settings(args, sampler, spp, seed, base))
 
 
 def cmd_render(args) -> int:
@@ -114,11 +122,8 @@ def cmd_render(args) -> int:
         # read before the render: a bad variance file fails now, not after it
         noise = reference_noise(args.reference, ref[..., :3].astype("float64"), args.crop or (0, 0, p.width, p.height))
     if args.progressive:
-        pres = render_progressive(scene, out=args.out, png=args.png, sampler=args.sampler, spp=args.spp,
-                                  seed=args.seed, base=args.base, **_size(args), max_depth=args.max_depth,
-                                  filter=args.filter, first=args.first, backend=args.backend,
-                                  shading=args.shading, time_budget=args.time, resume=args.resume,
-                                  quiet=args.quiet, command=_command(args))
+        pres = render_progressive(scene, p.settings, out=args.out, png=args.png, time_budget=args.time,
+                                  resume=args.resume, quiet=args.quiet, command=_command(args))
         image = pres.image
         if not args.quiet:
             base = f" (base {pres.base})" if pres.base else ""
@@ -128,12 +133,10 @@ def cmd_render(args) -> int:
                   f"{' and ' + args.png if args.png else ''} (running sum in {state_path(args.out)})")
     else:
         with engine(args.workers, args.scheduler) as eng:
-            res = render_on(eng, scene, sampler=args.sampler, spp=args.spp, seed=args.seed, **_size(args),
-                            max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                            shading=args.shading, progress=not args.quiet, base=args.base)
+            res = render_on(eng, scene, p.settings, progress=not args.quiet)
         check_finite(res.image, f"--out {args.out!r} not written")  # before either file is written
-        write_exr(args.out, res.image, describe(scene, p, kind="render", seed=args.seed, filter=args.filter,
-                                                shading=res.shading, command=_command(args)))
+        write_exr(args.out, res.image, describe(scene, p, kind="render", shading=res.shading,
+                                                command=_command(args)))
         if args.png:
             write_png(args.png, res.image)
         image = res.image
@@ -244,9 +247,7 @@ def cmd_compare(args) -> int:
 def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, crops: list) -> dict:
     """Render one sampler and seed of ``pyoa compare`` on ``eng``: its CSV row; what the figure shows of
     each sampler's first seed (:func:`figure_panels`) is appended to ``crops``."""
-    res = render_on(eng, scene, sampler=name, spp=spp, seed=seed, **_size(args), max_depth=args.max_depth,
-                    filter=args.filter, first=args.first, backend=args.backend, shading=args.shading,
-                    progress=not args.quiet)
+    res = render_on(eng, scene, _settings(args, name, spp, seed), progress=not args.quiet)
     check_finite(res.image, f"the {name} render ({spp} spp, seed {seed})")  # a NaN relMSE is no answer
     row = dict(sampler=name, spp_asked=args.spp, spp=spp, seed=seed, relmse=rel_mse(res.image, ref),
                relmse_crop=rel_mse(res.image, ref, crop), seconds=round(res.seconds, 3))
@@ -406,16 +407,13 @@ def cmd_reference(args) -> int:
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.pass_spp)
     _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
-    shading = resolve_shading(args.shading)
-    key = reference_key(scene, p, pass_spp=args.pass_spp, passes=passes, seed=args.seed, filter=args.filter,
-                        shading=shading)
-    kwargs = dict(sampler=args.sampler, spp=args.pass_spp, **_size(args), max_depth=args.max_depth,
-                  filter=args.filter, first=args.first, backend=args.backend, shading=shading)
-    meta = describe(scene, p, kind="reference", seed=args.seed, filter=args.filter, shading=shading,
-                    command=_command(args), passes=passes, pass_spp=args.pass_spp)
+    key = reference_key(scene, p, pass_spp=args.pass_spp, passes=passes, seed=args.seed)
+    # the client's shading, not each worker's $PYOA_SHADING: one reference
+    settings = p.settings.replace(shading=p.shading)
+    meta = describe(scene, p, kind="reference", command=_command(args), passes=passes, pass_spp=args.pass_spp)
     meta["spp"] = args.spp  # the reference's samples per pixel; the plan's is one pass's
     with engine(args.workers, args.scheduler) as eng:
-        _, var = render_reference(eng, scene, out=args.out, key=key, kwargs=kwargs, seed=args.seed,
+        _, var = render_reference(eng, scene, out=args.out, key=key, settings=settings, seed=args.seed,
                                   quiet=args.quiet, metadata=meta)
     if not args.quiet:
         where = "" if eng.client is None else f" on {eng.description}"

@@ -47,7 +47,8 @@ from .. import catalogue
 from .image import check_finite, write_exr, write_png
 from .integrator import RENDERER_VERSION, Stats
 from .provenance import describe
-from .render import plan, render, resolve_shading
+from .render import plan, render
+from .settings import RenderSettings
 from .state import (
     BadState,
     check_state_file,
@@ -168,23 +169,27 @@ def _bar(name: str, smp, done: int, quiet: bool):
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total} spp [{elapsed}<{remaining}{postfix}]")
 
 
-def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, seed: int = 0,
-                       base: int | None = None, width: int | None = None, height: int | None = None,
-                       max_depth: int | None = None, filter: str = "box", first=None, backend: str | None = None,
-                       shading: str | None = None, png=None, time_budget: float | None = None,
-                       resume: bool = False, quiet: bool = True, max_bytes=None,
-                       command: str | None = None) -> ProgressiveResult:
+#: The settings of a progressive render that are not given: ``faure`` to 1,024 samples per pixel.
+DEFAULTS = RenderSettings(sampler="faure", spp=1024)
+
+
+def render_progressive(scene, settings: RenderSettings | None = None, /, *, out, png=None,
+                       time_budget: float | None = None, resume: bool = False, quiet: bool = True,
+                       command: str | None = None, **changes) -> ProgressiveResult:
     """Render ``scene`` progressively to the EXR ``out`` (module docstring).
 
     Parameters
     ----------
+    settings : RenderSettings, optional
+        As for :func:`pyoa.render.render` (default :data:`DEFAULTS`), or
+        its fields as keyword arguments, which replace those of
+        ``settings``; the sampler must be progressive
+        (:func:`check_progressive`). ``spp`` is the most samples rendered.
+        Its ``batch_paths`` is not used: each block is one render.
     out : path
         EXR written after every block (atomically); the running sum is kept
         in ``OUT.state.npz`` (:func:`state_path`), which stays after the
         render so that it can be continued to more samples.
-    sampler, spp, seed, base, width, height, max_depth, filter, first, backend, shading, max_bytes
-        As for :func:`pyoa.render.render`; the sampler must be progressive
-        (:func:`check_progressive`). ``spp`` is the most samples rendered.
     png : path, optional
         Also write an sRGB PNG after every block.
     time_budget : float, optional
@@ -211,6 +216,8 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
         :func:`pyoa.render.plan` refuses; all before the first sample.
     """
     t_start = time.perf_counter()
+    settings = RenderSettings.of(settings or DEFAULTS, **changes)
+    sampler, base = settings.sampler, settings.base
     check_progressive(sampler)
     if time_budget is not None:
         if isinstance(time_budget, bool) or not isinstance(time_budget, (int, float)):
@@ -223,15 +230,15 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
     saved = saved_key(state) if resume and state.exists() else None
     if base is None and saved and saved.get("sampler") == entry.name and saved.get("base") is not None:
         base = saved["base"]  # the default base depends on spp: keep the stopped render's
-    p = plan(scene, sampler=sampler, spp=spp, seed=seed, width=width, height=height, max_depth=max_depth,
-             filter=filter, first=first, backend=backend, base=base, max_bytes=max_bytes)
+    p = plan(scene, settings, base=base)
     smp = p.sampler
+    # every block renders the whole film with the planned sampler (its base chosen once)
+    settings = p.settings.replace(width=p.width, height=p.height, spp=smp.spp, base=smp.base)
     key = dict(version=STATE_VERSION, renderer=RENDERER_VERSION, scene=scene_digest(scene), width=p.width,
                height=p.height, max_depth=p.layout.max_depth, sampler=smp.name, base=smp.base, seed=smp.seed,
-               filter=filter, first=list(p.layout.names), shading=resolve_shading(shading),
+               filter=settings.filter, first=list(p.layout.names), shading=p.shading,
                spp=None if entry.spp_invariant else smp.spp)
-    meta = describe(scene, p, kind="progressive render", seed=smp.seed, filter=filter,
-                    shading=resolve_shading(shading), command=command)
+    meta = describe(scene, p, kind="progressive render", command=command)
     total, done = None, 0
     if resume and state.exists():
         try:
@@ -269,10 +276,8 @@ def render_progressive(scene, *, out, sampler: str = "faure", spp: int = 1024, s
                               f"{time_budget:g} s (about {elapsed + last_rate * n:.0f} s): stopped")
                 break
             t0 = time.perf_counter()
-            res = render(scene, sampler=sampler, spp=smp.spp, seed=seed, width=p.width, height=p.height,
-                         max_depth=max_depth, filter=filter, first=first, backend=backend, shading=shading,
-                         max_bytes=max_bytes, base=smp.base, samples=range(done, end), sums=block,
-                         integrator=integrator, progress=bar if bar is not None else False)
+            res = render(scene, settings, samples=range(done, end), sums=block, integrator=integrator,
+                         progress=bar if bar is not None else False)
             integrator = res.integrator
             last_rate = (time.perf_counter() - t0) / n
             check_finite(res.image, f"--out {str(out)!r} not updated past {done} samples")

@@ -63,12 +63,13 @@ def command_line(argv) -> str:
     return shlex.join(["pyoa", *map(str, argv)])
 
 
-def describe(scene, p, *, kind: str, seed: int, filter: str, shading: str, command: str | None = None,
-             **extra) -> dict:
+def describe(scene, p, *, kind: str, command: str | None = None, shading: str | None = None, **extra) -> dict:
     """The attributes of an image of ``scene`` rendered as planned by ``p``
-    (:func:`pyoa.render.render.plan`), with the settings the plan does not
-    hold; ``extra`` adds kind-specific ones (``samples``, ``passes``,
-    ``pass_spp``). Values are str or int."""
+    (:func:`pyoa.render.render.plan`, whose settings give the seed, filter
+    and shading; ``shading`` names the one that rendered where it differs,
+    after a fallback to the NumPy reference); ``extra`` adds kind-specific
+    ones (``samples``, ``passes``, ``pass_spp``) or replaces one (a
+    reference's ``spp``). Values are str or int."""
     from .. import __version__
     from ..hostcpu import host_cpu
     from .integrator import RENDERER_VERSION
@@ -76,11 +77,11 @@ def describe(scene, p, *, kind: str, seed: int, filter: str, shading: str, comma
 
     smp = p.sampler
     meta = {"kind": kind, "scene": scene.name, "scene_file": str(scene.path), "scene_sha256": scene_digest(scene),
-            "width": p.width, "height": p.height, "sampler": smp.name, "spp": smp.spp, "seed": int(seed)}
+            "width": p.width, "height": p.height, "sampler": smp.name, "spp": smp.spp, "seed": int(smp.seed)}
     if smp.base is not None:
         meta["base"] = int(smp.base)
     meta.update({k: v for k, v in extra.items() if v is not None})
-    meta.update({"max_depth": p.layout.max_depth, "filter": filter, "shading": shading,
+    meta.update({"max_depth": p.layout.max_depth, "filter": p.settings.filter, "shading": shading or p.shading,
                  "layout": p.layout.describe(), "renderer": RENDERER_VERSION, "version": __version__,
                  "git": git_revision(), "cpu": host_cpu().describe()})
     if command:

@@ -30,6 +30,7 @@ import numpy as np
 
 from .image import check_finite, write_exr
 from .integrator import RENDERER_VERSION
+from .settings import RenderSettings
 from .state import (
     BadState,
     check_state_file,
@@ -93,13 +94,14 @@ def reference_noise(path, reference: np.ndarray, crop) -> tuple[float, float] | 
     return relmse_noise(var, reference), relmse_noise(var, reference, crop)
 
 
-def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int, filter: str, shading: str) -> dict:
-    """Every setting that changes the bits of a reference pass (the backend
-    and the engine do not: every backend gives the same samples, every engine
-    the same images)."""
+def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int) -> dict:
+    """Every setting that changes the bits of a reference of ``passes``
+    passes planned as ``p`` (:func:`~pyoa.render.render.plan` of one pass)
+    (the backend and the engine do not: every backend gives the same
+    samples, every engine the same images)."""
     return dict(version=STATE_VERSION, renderer=RENDERER_VERSION, scene=scene_digest(scene), width=p.width,
                 height=p.height, max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=pass_spp,
-                passes=passes, seed=seed, filter=filter, first=list(p.layout.names), shading=shading)
+                passes=passes, seed=seed, filter=p.settings.filter, first=list(p.layout.names), shading=p.shading)
 
 
 def _total_spp(key: dict):
@@ -192,21 +194,22 @@ class Passes:
         return None if self.passes < 2 else pass_variance(self.total, self.sumsq, self.passes)
 
 
-def pass_task(scene, kwargs: dict, seed: int, k: int, threads: int | None):
+def pass_task(scene, settings: RenderSettings, seed: int, k: int, threads: int | None):
     """One reference pass: ``(k, float32 image)``, checked finite."""
-    res = worker_render(scene, dict(kwargs, seed=pass_seed(seed, k)), threads=threads)
+    res = worker_render(scene, settings.replace(seed=pass_seed(seed, k)), threads=threads)
     # a NaN pass would spoil every later pass's mean: stop at the first
     check_finite(res.image, f"pass {k}")
     return k, res.image
 
 
-def render_reference(eng, scene, *, out, key: dict, kwargs: dict, seed: int, quiet: bool = False,
+def render_reference(eng, scene, *, out, key: dict, settings: RenderSettings, seed: int, quiet: bool = False,
                      command: str = "pyoa reference",
                      metadata: dict | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """Render (or resume) the reference of ``key`` on the engine ``eng``
     and write ``out`` and its variance (:func:`variance_path`); returns
-    ``(mean, variance)``. ``kwargs`` are :func:`~pyoa.render.render.render`'s
-    for one pass (the seed aside); every check has been made by the caller.
+    ``(mean, variance)``. ``settings`` are one pass's (its seed is
+    :func:`pass_seed` of ``seed`` and the pass); every check has been made
+    by the caller.
     ``metadata`` (:func:`pyoa.render.provenance.describe`) goes into both
     files' headers, with their kinds."""
     from tqdm.auto import tqdm
@@ -218,7 +221,7 @@ def render_reference(eng, scene, *, out, key: dict, kwargs: dict, seed: int, qui
     todo = acc.todo
     src = eng.share(scene if eng.client is None else source_of(scene))
     threads = eng.task_threads()
-    results = eng.run(pass_task, [(src, kwargs, seed, k, threads) for k in todo], key="pyoa-pass")
+    results = eng.run(pass_task, [(src, settings, seed, k, threads) for k in todo], key="pyoa-pass")
     with closing(results), tqdm(total=acc.passes, initial=acc.finished, desc=f"{Path(out).name} passes",
                                 unit="pass", disable=quiet) as bar:
         for _, (k, image) in results:

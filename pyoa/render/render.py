@@ -27,9 +27,8 @@ from ..units import format_bytes
 from .camera import check_filter
 from .integrator import Integrator, Stats
 from .layout import MAX_DEPTH, Layout
+from .settings import BATCH_PATHS, RenderSettings
 
-#: Camera paths per batch (bounds the working set: ~1 KiB per path).
-BATCH_PATHS = 1 << 16
 #: Working memory of one camera path in flight, besides its row of sampler
 #: values: measured peaks are ~0.3 KiB (compiled shading) and ~1.1 KiB (NumPy
 #: shading, 46 dimensions, sampler row included), so 1 KiB plus 8 bytes per
@@ -81,6 +80,8 @@ class RenderResult:
     #: (integrator, shading) that rendered it, for a later render of the same
     #: scene and settings to reuse (``render(..., integrator=)``)
     integrator: tuple | None = field(default=None, repr=False, compare=False)
+    #: the settings it was rendered with, as asked (None where the scene's value applied)
+    settings: RenderSettings | None = None
 
     @property
     def paths_per_second(self) -> float:
@@ -173,37 +174,45 @@ class Plan:
     sampler: object  # pyoa.samplers.Sampler
     nbytes: int  # the render's peak with the scene's tracer (render_bytes + scene_bytes)
     max_bytes: int
+    settings: RenderSettings  # as asked (None where the scene's value applies)
+
+    @property
+    def shading(self) -> str:
+        """The shading the render uses (:func:`resolve_shading` of the settings')."""
+        return resolve_shading(self.settings.shading)
 
 
-def plan(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
-         height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
-         backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
-         max_bytes: int | str | None = None, base: int | None = None) -> Plan:
-    """Check the arguments of :func:`render` (same meanings) and the memory it
-    needs, without rendering: every error a render can raise on its arguments
-    is raised here, before anything large is allocated."""
-    limit = resolve_max_bytes(max_bytes)
-    width, height = image_size(scene, width, height, limit)
-    depth = _count("max_depth", max_depth, scene.max_depth, MAX_DEPTH)
-    check_filter(filter)
-    batch_paths = _count("batch_paths", batch_paths)
+def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | None = None, **changes) -> Plan:
+    """Check the settings of :func:`render` (a :class:`RenderSettings`, or
+    its fields as keyword arguments, which replace those of ``settings``)
+    and the memory the render needs on ``threads`` workers, without
+    rendering: every error a render can raise on its arguments is raised
+    here, before anything large is allocated."""
+    s = RenderSettings.of(settings, **changes)
+    limit = resolve_max_bytes(s.max_bytes)
+    width, height = image_size(scene, s.width, s.height, limit)
+    depth = _count("max_depth", s.max_depth, scene.max_depth, MAX_DEPTH)
+    check_filter(s.filter)
+    batch_paths = _count("batch_paths", s.batch_paths)
     if threads is not None:
         threads = _count("threads", threads)
+    if s.shading is not None:
+        resolve_shading(s.shading)
     cam = scene.camera
     layout = Layout(max_depth=depth, mis=scene.mis, lens=cam.aperture > 0,
-                    time=bool(np.any(np.asarray(cam.motion) != 0)), first=first)
+                    time=bool(np.any(np.asarray(cam.motion) != 0)), first=s.first)
     # a sampler whose values depend on the image (zsobol) gets the film's
     # size; pixels are numbered row-major, y * width + x, as render() does
-    image = {"resolution": (width, height)} if catalogue.get(sampler).needs_resolution else {}
-    smp = make_sampler(sampler, spp=spp, dims=max(layout.dims, 1), seed=seed, backend=backend, max_bytes=limit,
-                       base=base, **image)
+    image = {"resolution": (width, height)} if catalogue.get(s.sampler).needs_resolution else {}
+    smp = make_sampler(s.sampler, spp=s.spp, dims=max(layout.dims, 1), seed=s.seed, backend=s.backend,
+                       max_bytes=limit, base=s.base, **image)
     # the scene's tracer (Embree's BVH) counts too: it is built before the first sample
     traced = scene_bytes(scene)
     nbytes = traced + render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
     fix = (f"render a scene of fewer triangles (its {len(scene.triangles)} triangles take {format_bytes(traced)} "
            "to trace)" if 2 * traced > nbytes else "render fewer pixels or samples")
     check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit, fix)
-    return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit)
+    return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit, settings=s)
 
 
 def _sub_range(name: str, r, n: int, what: str) -> range:
@@ -236,33 +245,22 @@ def _warn_fallback(exc: BaseException) -> None:
                       "silence this.", ShadingFallbackWarning, stacklevel=3)
 
 
-def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width: int | None = None,
-           height: int | None = None, max_depth: int | None = None, filter: str = "box", first=None,
-           backend: str | None = None, batch_paths: int = BATCH_PATHS, threads: int | None = None,
-           progress: bool = False, shading: str | None = None, max_bytes: int | str | None = None,
-           base: int | None = None, samples: range | None = None, sums: np.ndarray | None = None,
-           integrator=None, pixels: range | None = None) -> RenderResult:
-    """Render ``scene`` (a :class:`pyoa.render.scene.Scene`) with ``spp`` samples per pixel.
+def render(scene, settings: RenderSettings | None = None, /, *, threads: int | None = None,
+           progress: bool = False, samples: range | None = None, sums: np.ndarray | None = None,
+           integrator=None, pixels: range | None = None, **changes) -> RenderResult:
+    """Render ``scene`` (a :class:`pyoa.render.scene.Scene`) with ``settings``.
 
     Parameters
     ----------
-    sampler : str
-        Any name of :func:`pyoa.samplers`; ``spp`` must be one of its valid
-        counts (:func:`pyoa.valid_spp`), else a ValueError names the nearest.
-    seed : int
-        User seed of the sampler (uint32).
-    width, height, max_depth : int, optional
-        Override the scene's film size and path length (segments, as Mitsuba);
-        integers >= 1 (None: the scene's; 0 is refused, not read as None).
-    filter : {"box", "gaussian"}
-        Pixel filter (see :class:`.integrator.Integrator`).
-    first : sequence of str, optional
-        Integrand dimensions to map to the first sampler dimensions (see
-        :mod:`.layout`).
-    backend : str, optional
-        Sampler backend (``"opencl"``, ``"numpy"``; default automatic).
-    batch_paths : int
-        Camera paths per batch (rounded to whole pixels).
+    settings : RenderSettings, optional
+        What to render: the sampler, ``spp``, seed, film size, path length,
+        filter, layout, base, backend, shading, batch size and memory limit
+        (:class:`~pyoa.render.settings.RenderSettings`, whose docstring
+        says what each means). Its fields may also be given as keyword
+        arguments, which replace those of ``settings``:
+        ``render(scene, sampler="bose", spp=121)``. Both shadings estimate
+        the same image, and each gives the same bits for any batch size and
+        thread count.
     threads : int, optional
         Worker threads (default: the number of CPUs).
     progress : bool or tqdm-like, optional
@@ -272,19 +270,6 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         (``samples x batch pixels / image pixels``), so that one bar can
         follow several renders of the same image in samples per pixel (a
         progressive render's blocks do).
-    shading : {"numba", "numpy"}, optional
-        ``"numba"`` (default): shading compiled with numba, Embree called from
-        it (:mod:`pyoa.render.compiled`); ``"numpy"``: the NumPy reference
-        (:mod:`pyoa.render.integrator`). Default ``$PYOA_SHADING``, else numba.
-        Both estimate the same image; each gives the same bits for any batch
-        size and thread count.
-    max_bytes : int or str, optional
-        Memory limit (default ``$PYOA_MAX_BYTES``, else half of the memory the process may use, as
-        the samplers'): a render that would need more (:func:`render_bytes`,
-        and :func:`scene_bytes` for the scene's tracer) is refused with a
-        ValueError before anything is allocated.
-    base : int, optional
-        The digit base of ``faure`` (refused by the other samplers).
     samples : range, optional
         Render only the samples ``samples`` (a contiguous ``range(a, c)``
         with step 1 inside ``[0, spp)``) of every pixel: the image is their
@@ -296,7 +281,8 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         mean is formed); the image is still returned.
     integrator : optional
         ``RenderResult.integrator`` of an earlier render of the same scene
-        with the same size, path length, layout and filter, reused instead of
+        with the same :meth:`~pyoa.render.settings.RenderSettings.integrator_key`
+        (size, path length, layout, filter, shading), reused instead of
         built again (its setup, and the first call's compilation, are paid
         once: a progressive render's blocks share one).
     pixels : range, optional
@@ -312,12 +298,9 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
         Invalid arguments or a render over the memory limit, all checked by
         :func:`plan` before the first sample.
     """
-    explicit = shading is not None
-    shading = resolve_shading(shading)
-    p = plan(scene, sampler=sampler, spp=spp, seed=seed, width=width, height=height, max_depth=max_depth,
-             filter=filter, first=first, backend=backend, batch_paths=batch_paths, threads=threads,
-             max_bytes=max_bytes, base=base)
+    p = plan(scene, settings, threads=threads, **changes)
     width, height, layout, smp = p.width, p.height, p.layout, p.sampler
+    explicit, shading, filter = p.settings.shading is not None, p.shading, p.settings.filter
     spp, seed = smp.spp, smp.seed
     samples = _sub_range("samples", samples, spp, "the sampler's spp")
     n = len(samples)
@@ -346,7 +329,7 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     if integrator is None:
         integrator = (integ, shading)
     n_pixels = len(tile)
-    per_batch = max(1, batch_paths // n)
+    per_batch = max(1, p.settings.batch_paths // n)
     batches = [(p0, min(p0 + per_batch, tile.stop)) for p0 in range(tile.start, tile.stop, per_batch)]
     out = np.empty((n_pixels, 3), dtype=np.float32)
     flat_sums = None if sums is None else sums.reshape(n_pixels, 3)
@@ -388,7 +371,7 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
             from tqdm.auto import tqdm
 
             what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
-            bar = tqdm(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {sampler} {what}")
+            bar = tqdm(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {smp.name} {what}")
     workers = max(1, min(threads or os.cpu_count() or 1, len(batches)))
     try:
         with ThreadPoolExecutor(workers) as pool:
@@ -404,4 +387,5 @@ def render(scene, *, sampler: str = "bose", spp: int = 121, seed: int = 0, width
     seconds = time.perf_counter() - t0
     return RenderResult(image=out.reshape(shape), sampler=smp.name, spp=n, seed=seed,
                         dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total, shading=shading,
-                        timings=dict(getattr(integ, "timings", {})), integrator=integrator, compiled=compiled)
+                        timings=dict(getattr(integ, "timings", {})), integrator=integrator, compiled=compiled,
+                        settings=p.settings)

@@ -27,6 +27,7 @@ import numpy as np
 from .integrator import Stats
 from .render import BATCH_PATHS, RenderResult, plan, render
 from .scene_source import SceneSource, load_source, source_of
+from .settings import RenderSettings
 from .state import scene_digest
 
 #: Tiles per task slot of the engine: enough that slots finishing early find work.
@@ -40,23 +41,18 @@ _DIGESTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _MAX_INTEGRATORS = 16
 
 
-def _integrator_key(digest: str, kwargs: dict) -> tuple:
-    """What an integrator depends on: the scene, film size, path length, layout, filter, shading."""
-    return (digest, kwargs.get("width"), kwargs.get("height"), kwargs.get("max_depth"), kwargs.get("filter"),
-            tuple(kwargs.get("first") or ()), kwargs.get("shading"))
-
-
-def worker_render(src, kwargs: dict, *, pixels: range | None = None, threads: int | None = None) -> RenderResult:
+def worker_render(src, settings: RenderSettings, *, pixels: range | None = None,
+                  threads: int | None = None) -> RenderResult:
     """:func:`render` of the scene ``src`` (a :class:`SceneSource` on a
     worker, the :class:`~pyoa.render.scene.Scene` itself in-process) with
-    ``kwargs`` in this process, reusing this process's integrator for the
-    same scene and settings."""
+    ``settings`` in this process, reusing this process's integrator for the
+    same scene and :meth:`~RenderSettings.integrator_key`."""
     if isinstance(src, SceneSource):
         scene, digest = load_source(src), src.digest
     else:  # in-process: the Scene itself, hashed once (a study renders it hundreds of times)
         scene, digest = src, _DIGESTS.get(src) or _DIGESTS.setdefault(src, scene_digest(src))
-    key = _integrator_key(digest, kwargs)
-    res = render(scene, **kwargs, pixels=pixels, threads=threads, integrator=_INTEGRATORS.get(key))
+    key = (digest, *settings.integrator_key())
+    res = render(scene, settings, pixels=pixels, threads=threads, integrator=_INTEGRATORS.get(key))
     if key not in _INTEGRATORS:
         if len(_INTEGRATORS) >= _MAX_INTEGRATORS:
             _INTEGRATORS.pop(next(iter(_INTEGRATORS)))
@@ -65,9 +61,9 @@ def worker_render(src, kwargs: dict, *, pixels: range | None = None, threads: in
     return res
 
 
-def tile_task(src: SceneSource, kwargs: dict, pixels: range, threads: int | None):
+def tile_task(src: SceneSource, settings: RenderSettings, pixels: range, threads: int | None):
     """One tile: ``(pixels.start, float32 means (len(pixels), 3), Stats)``."""
-    res = worker_render(src, kwargs, pixels=pixels, threads=threads)
+    res = worker_render(src, settings, pixels=pixels, threads=threads)
     return pixels.start, res.image, res.stats
 
 
@@ -81,20 +77,21 @@ def tile_ranges(n_pixels: int, spp: int, slots: int) -> list[range]:
     return [range(a, min(a + size, n_pixels)) for a in range(0, n_pixels, size)]
 
 
-def render_on(eng, scene, *, progress: bool = False, **kwargs) -> RenderResult:
-    """Render ``scene`` with :func:`render`'s keyword arguments on the engine
+def render_on(eng, scene, settings: RenderSettings | None = None, /, *, progress: bool = False,
+              **changes) -> RenderResult:
+    """Render ``scene`` with ``settings`` (a :class:`RenderSettings`, or its
+    fields as keyword arguments, as :func:`render` takes them) on the engine
     ``eng``: in-process, :func:`render` itself; on a cluster, in tiles whose
     assembled image is bit-identical to it.
 
-    Every argument is checked on the client first (:func:`plan`), before any
+    Every setting is checked on the client first (:func:`plan`), before any
     task is submitted."""
+    settings = RenderSettings.of(settings, **changes)
     if eng.client is None:
-        return render(scene, progress=progress, **kwargs)
-    from .render import resolve_shading
-
+        return render(scene, settings, progress=progress)
     # the client's shading, not each worker's $PYOA_SHADING: one image
-    kwargs = dict(kwargs, shading=resolve_shading(kwargs.get("shading")))
-    p = plan(scene, **{k: v for k, v in kwargs.items() if k != "shading"})
+    p = plan(scene, settings)
+    settings = settings.replace(shading=p.shading)
     src = source_of(scene)
     tiles = tile_ranges(p.width * p.height, p.sampler.spp, eng.slots)
     threads = eng.task_threads()
@@ -104,7 +101,7 @@ def render_on(eng, scene, *, progress: bool = False, **kwargs) -> RenderResult:
 
     t0 = time.perf_counter()
     src = eng.share(src)
-    with closing(eng.run(tile_task, [(src, kwargs, t, threads) for t in tiles], key="pyoa-tile")) as results:
+    with closing(eng.run(tile_task, [(src, settings, t, threads) for t in tiles], key="pyoa-tile")) as results:
         for _, (start, means, st) in progress_over(results, len(tiles), f"{scene.name} {p.sampler.name} "
                                                    f"{p.sampler.spp} spp", not progress, unit="tile"):
             out[start:start + len(means)] = means
@@ -112,4 +109,4 @@ def render_on(eng, scene, *, progress: bool = False, **kwargs) -> RenderResult:
     seconds = time.perf_counter() - t0
     return RenderResult(image=out.reshape(p.height, p.width, 3), sampler=p.sampler.name, spp=p.sampler.spp,
                         seed=p.sampler.seed, dims=p.layout.dims, layout=p.layout.describe(), seconds=seconds,
-                        stats=stats, shading=kwargs["shading"])
+                        stats=stats, shading=settings.shading, settings=settings)

@@ -210,8 +210,8 @@ def test_work_of_another_renderer_version_is_not_mixed_in(progressive_state, tmp
 
     ref = tmp_path / "ref.exr"
     scene = load("cornell")
-    p = plan(scene, sampler="sobol", spp=4, width=8, height=8)
-    key = reference_key(scene, p, pass_spp=4, passes=1, seed=0, filter="box", shading="numpy")
+    p = plan(scene, sampler="sobol", spp=4, width=8, height=8, shading="numpy")
+    key = reference_key(scene, p, pass_spp=4, passes=1, seed=0)
     Passes(state_path(ref), key, quiet=True).add(0, np.ones((8, 8, 3), np.float32))
     _as_renderer_1(state_path(ref))
     res = pyoa([*REFERENCE, "--size", "8", "8", "--out", ref, "-q"], as_limit)
@@ -236,8 +236,8 @@ def test_a_forged_header_of_a_reference_state_starts_over(tmp_path, as_limit):
     says why in one line and renders afresh, nothing allocated from the header."""
     out = tmp_path / "ref.exr"
     scene = load("cornell")
-    p = plan(scene, sampler="sobol", spp=4, width=8, height=8)
-    key = reference_key(scene, p, pass_spp=4, passes=1, seed=0, filter="box", shading="numpy")
+    p = plan(scene, sampler="sobol", spp=4, width=8, height=8, shading="numpy")
+    key = reference_key(scene, p, pass_spp=4, passes=1, seed=0)
     Passes(state_path(out), key, quiet=True).add(0, np.ones((8, 8, 3), np.float32))  # a finished pass, saved
     forge(state_path(out), "sum.npy", (40000, 40000, 3))
     res = pyoa([*REFERENCE, "--size", "8", "8", "--out", out, "-q"], as_limit)

@@ -369,11 +369,11 @@ def record_passes(monkeypatch, fail_at=None):
     simulate an interrupted run. Returns the list of seeds."""
     calls = []
 
-    def wrapped(*args, **kwargs):
-        calls.append(kwargs["seed"])
+    def wrapped(scene, settings, **kwargs):
+        calls.append(settings.seed)
         if len(calls) == fail_at:
             raise KeyboardInterrupt
-        return REAL_RENDER(*args, **kwargs)
+        return REAL_RENDER(scene, settings, **kwargs)
 
     monkeypatch.setattr(tiles, "render", wrapped)
     return calls
