@@ -278,7 +278,53 @@ def test_scratch_rows_do_not_overlap():
     from pyoa.render.compiled import shading as sh
 
     sizes_and_imports = ("CHUNK", "ROW", "SCRATCH", "HIT_FIELDS", "DIFFUSE", "MIRROR", "RR_KEY")
-    rows = sorted(v for k, v in vars(sh).items() if k.isupper() and isinstance(v, int) and k not in sizes_and_imports)
+    rows = sorted(v for k, v in vars(sh).items()
+                  if k.isupper() and not k.startswith("_") and isinstance(v, int) and k not in sizes_and_imports)
     assert rows == [k * sh.ROW for k in range(len(rows))]
     assert sh.ROW >= sh.CHUNK and (sh.ROW * 8) % 4096 != 0 and rows[-1] + sh.ROW <= sh.SCRATCH
     assert sh.CB - sh.V0X == (sh.HIT_FIELDS - 1) * sh.ROW  # gather copies hit_data's row into V0X .. CB
+
+
+@pytest.mark.parametrize("name", ["cornell", "deep"])
+@pytest.mark.parametrize("mis", [True, False])
+def test_the_last_bounce_adds_what_the_full_shading_would(name, mis):
+    """emission_only (the last bounce: emission alone, one entry at a time)
+    adds to every path the same bits as gathering the hits and running
+    head and emit_and_choose on them: rays from inside the scene in every
+    direction, some from emitters' backs, with random throughputs, previous
+    pdfs and delta flags, at depth 1 and deeper."""
+    from pyoa.render import embree
+    from pyoa.render.compiled import shading as sh
+    from pyoa.render.layout import Layout
+
+    scene = load(name)
+    integ = ci.CompiledIntegrator(scene, Layout(max_depth=3, mis=mis, lens=False, time=False), 8, 8)
+    sc, tr = integ._scene, integ._tracer
+    ps = integ._settings._replace(mis=mis)
+    rng = np.random.default_rng(5)
+    n = 8000
+    w = ci.new_wavefront(n)
+    lo, hi = scene.triangles.reshape(-1, 3).min(axis=0), scene.triangles.reshape(-1, 3).max(axis=0)
+    w.o[:] = lo + (hi - lo) * rng.uniform(0.02, 0.98, size=(n, 3))
+    d = rng.normal(size=(n, 3))
+    w.d[:] = d / np.linalg.norm(d, axis=1)[:, None]
+    embree.intersect(tr.scene, tr.hit, tr.packet, w.o, w.d, w.prim, w.t)
+    assert np.count_nonzero(sc.emission[w.prim[w.prim >= 0]].any(axis=1)) >= 10  # some rays see emitters
+    w.lane[:] = rng.permutation(n)
+    w.beta[:] = rng.uniform(0, 2, size=(n, 3))
+    w.prev_pdf[:] = rng.uniform(0, 3, size=n)
+    w.prev_delta[:] = rng.random(n) < 0.3
+    x = np.zeros((n, 1), np.float32)
+    for depth in (1, 2, 3):
+        fast = np.zeros((n, 3))
+        sh.emission_only(n, depth, mis, sc, w, fast)
+        full = np.zeros((n, 3))
+        F, lanes = np.empty(sh.SCRATCH), np.empty(sh.CHUNK, np.int64)
+        for start in range(0, n, sh.CHUNK):
+            h = sh.gather(start, min(start + sh.CHUNK, n), 0, sc, ps, x, w, F, lanes)
+            sh.head(h, depth, mis, F)
+            for k in range(h):
+                if F[sh.SEEN + k] != 0.0:
+                    full[lanes[k]] += F[[sh.LE_R + k, sh.LE_G + k, sh.LE_B + k]]
+        assert np.count_nonzero(full.any(axis=1)) >= 10
+        assert fast.tobytes() == full.tobytes(), f"depth {depth}"

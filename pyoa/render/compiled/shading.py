@@ -21,6 +21,11 @@ For each chunk it
    (:func:`new_rays`), and plays Russian roulette while compacting the
    surviving lanes to the front of the wavefront (:func:`survivors`).
 
+The last bounce (the path's ``max_depth``-th segment, after which no light
+sample or new ray follows) only adds the emission its rays see:
+:func:`emission_only` does that one entry at a time for the few rays that
+hit an emitter's front, without the scratch.
+
 Steps 2, 4 and 5's lane loops contain no branches that depend on a lane
 (selects instead) and touch only the scratch, laid out as one flat array
 with rows :data:`CHUNK` apart: with the distance between rows a compile-time
@@ -232,17 +237,18 @@ def head(h, depth, mis, F):
 
 
 @njit(**_JIT)
-def emit_and_choose(h, next_event, sc, F, lanes, radiance):
-    """Add the emission each lane's ray sees to its path's radiance and, when
-    ``next_event``, choose a point on an emitter by power for each lane
-    whose BSDF is not a mirror (:func:`sample_emitter`, a binary search)."""
+def emit_and_choose(h, sc, F, lanes, radiance):
+    """Add the emission each lane's ray sees to its path's radiance and
+    choose a point on an emitter by power for each lane whose BSDF is not a
+    mirror (:func:`sample_emitter`, a binary search). (The last bounce has
+    no light sample: :func:`emission_only`.)"""
     for k in range(h):
         li = lanes[k]
         if F[SEEN + k] != 0.0:
             radiance[li, 0] += F[LE_R + k]
             radiance[li, 1] += F[LE_G + k]
             radiance[li, 2] += F[LE_B + k]
-        if next_event and F[KIND + k] != MIRROR:
+        if F[KIND + k] != MIRROR:
             etri, qx, qy, qz, mx, my, mz, pdf_area = sample_emitter(
                 sc.em, sc.em_cdf, sc.em_prob, sc.verts, sc.normals, sc.areas, F[LIGHT_U + k], F[LIGHT_V + k])
             F[QX + k], F[QY + k], F[QZ + k] = qx, qy, qz
@@ -424,6 +430,43 @@ def survivors(h, depth, rr_depth, F, lanes, sample_index, rr_key, w, live):
     return live
 
 
+#: Columns of :func:`hit_data`'s rows that the last bounce reads (the order
+#: of the rows ``V0X .. CB``): the normal, the emitted radiance and the pdf
+#: per unit area.
+_HIT_N, _HIT_E, _HIT_PDF = ((row - V0X) // ROW for row in (NX, ER, PDF_AREA_HIT))
+
+
+@njit(**_JIT)
+def emission_only(n, depth, mis, sc, w, radiance):
+    """The last bounce, after which no light sample and no new ray follow:
+    only the emission that each of the ``n`` entries' rays sees, added to
+    its path's radiance. One entry at a time, and only those whose ray hit
+    the front of an emitter do any arithmetic (few do): gathering every hit
+    into the scratch and computing the frames, offsets and the rest of
+    :func:`head` for them was most of a shallow scene's last bounce. The
+    operations of :func:`head` and :func:`emit_and_choose` on those values,
+    in the same order, so the same bits."""
+    hd = sc.hit_data
+    for i in range(n):
+        tri = w.prim[i]
+        if tri < 0:
+            continue  # the ray left the scene
+        er, eg, eb = hd[tri, _HIT_E], hd[tri, _HIT_E + 1], hd[tri, _HIT_E + 2]
+        if er == 0.0 and eg == 0.0 and eb == 0.0:
+            continue
+        dx, dy, dz = w.d[i, 0], w.d[i, 1], w.d[i, 2]
+        cos_l = -(hd[tri, _HIT_N] * dx + hd[tri, _HIT_N + 1] * dy + hd[tri, _HIT_N + 2] * dz)
+        if not cos_l > 0:
+            continue  # emitters are one-sided
+        ti = w.t[i]
+        pdf_light = hd[tri, _HIT_PDF] * ti * ti / max(cos_l, 1e-12)
+        wt = emission_weight(depth, mis, pdf_light, w.prev_pdf[i], w.prev_delta[i])
+        li = w.lane[i]
+        radiance[li, 0] += w.beta[i, 0] * er * wt
+        radiance[li, 1] += w.beta[i, 1] * eg * wt
+        radiance[li, 2] += w.beta[i, 2] * eb * wt
+
+
 @njit(**_JIT)
 def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance, F, lanes):
     """One bounce of the ``n`` live entries of the wavefront ``w``, whose
@@ -445,15 +488,16 @@ def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance, F, lanes):
     ``sc.growth``: as ``integrator.triangle_reach``).
     """
     next_event = depth < ps.max_depth
+    if not next_event:
+        emission_only(n, depth, ps.mis, sc, w, radiance)
+        return 0, 0
     # a new ray when it can find emission (MIS) or feed a later light sample
-    extend = next_event and (ps.mis or depth < ps.max_depth - 1)
+    extend = ps.mis or depth < ps.max_depth - 1
     live, shadows = 0, 0
     for start in range(0, n, CHUNK):
         h = gather(start, min(start + CHUNK, n), depth, sc, ps, x, w, F, lanes)
         head(h, depth, ps.mis, F)
-        emit_and_choose(h, next_event, sc, F, lanes, radiance)
-        if not next_event:
-            continue
+        emit_and_choose(h, sc, F, lanes, radiance)
         light_directions(h, F)
         evaluate_others(h, F)
         shadow_rays(h, ps.mis, F)
