@@ -97,26 +97,9 @@ def _kernels():
     :mod:`pyoa.reference.pmj02`, on int64 arrays."""
     import numba
 
+    from ._numba.hashes import hash_pair
+
     jit = numba.njit(cache=False)
-
-    @jit
-    def mul32(a, b):
-        # a * b mod 2**32 without int64 overflow (products below 2**48)
-        return (a * (b & 0xFFFF) + (((a * (b >> 16)) & 0xFFFF) << 16)) & 0xFFFFFFFF
-
-    @jit
-    def mix32(x):
-        x ^= x >> 16
-        x = mul32(x, 0x7FEB352D)
-        x ^= x >> 15
-        x = mul32(x, 0x846CA68B)
-        x ^= x >> 16
-        return x
-
-    @jit
-    def hash_pair(a, b, key):
-        h = mix32(b ^ mix32(a ^ key))
-        return h if h != 0 else key
 
     @jit
     def draw(seed, index, purpose, attempt):

@@ -198,15 +198,20 @@ def test_numba_cache_follows_every_source_the_compiled_code_comes_from(tmp_path)
 
     import pyoa.render.compiled as pkg
 
-    root = Path(pkg.__file__).resolve().parent.parent
-    # every module of pyoa.render that the compiled package imports is a source
+    root = Path(pkg.__file__).resolve().parent.parent.parent  # the pyoa package
+    # every module of pyoa that the compiled package imports is a source, with its package's __init__
     imported = set()
-    for path in (root / "compiled").glob("*.py"):
-        imported.add(f"compiled/{path.name}")
+    for path in (root / "render" / "compiled").glob("*.py"):
+        imported.add(f"render/compiled/{path.name}")
         for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.ImportFrom) and node.level == 2:
+            if isinstance(node, ast.ImportFrom) and node.level in (2, 3):
+                where = "render/" if node.level == 2 else ""
                 names = [node.module] if node.module else [a.name for a in node.names]
-                imported.update(f"{n}.py" for n in names)
+                for n in names:
+                    imported.add(where + n.replace(".", "/") + ".py")
+                    if "." in n:
+                        imported.add(where + n.rsplit(".", 1)[0].replace(".", "/") + "/__init__.py")
+    assert any(name.startswith("_numba/") for name in imported)  # the hashes are followed too
     assert imported <= set(pkg.SOURCES), imported - set(pkg.SOURCES)
     # the digest changes with any byte of any source
     for rel in pkg.SOURCES:

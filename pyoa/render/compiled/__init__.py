@@ -25,17 +25,18 @@ import hashlib
 import os
 from pathlib import Path
 
-_RENDER = Path(__file__).resolve().parent.parent
-#: Files (relative to ``pyoa/render``) whose code or constants the compiled
-#: functions contain: this package and every module of ``pyoa.render`` that
-#: it imports (``tests/render/test_compiled.py`` checks the list against the
-#: imports).
-SOURCES = ("compiled/__init__.py", "compiled/bsdf.py", "compiled/camera.py", "compiled/emitters.py",
-           "compiled/geometry.py", "compiled/integrator.py", "compiled/shading.py", "bsdf.py", "camera.py", "embree.py", "emitters.py",
-           "integrator.py")
+_PYOA = Path(__file__).resolve().parent.parent.parent
+#: Files (relative to the ``pyoa`` package) whose code or constants the
+#: compiled functions contain: this package, every module of ``pyoa.render``
+#: that it imports and the numba hashes it calls (:mod:`pyoa._numba`)
+#: (``tests/render/test_compiled.py`` checks the list against the imports).
+SOURCES = tuple(f"render/{name}" for name in (
+    "compiled/__init__.py", "compiled/bsdf.py", "compiled/camera.py", "compiled/emitters.py", "compiled/geometry.py",
+    "compiled/integrator.py", "compiled/shading.py", "bsdf.py", "camera.py", "embree.py", "emitters.py",
+    "integrator.py")) + ("_numba/__init__.py", "_numba/hashes.py")
 
 
-def sources_digest(root: Path = _RENDER) -> str:
+def sources_digest(root: Path = _PYOA) -> str:
     """SHA-256 of the names and bytes of :data:`SOURCES` under ``root``."""
     h = hashlib.sha256()
     for rel in SOURCES:

@@ -37,13 +37,14 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
+from ..._numba.hashes import hash_pair
 from .. import embree
 from .. import integrator as reference
 from ..camera import filter_offsets
 from ..integrator import RR_KEY, Stats
 from .camera import SCRATCH as CAMERA_SCRATCH
 from .camera import camera_rays
-from .shading import CHUNK, SCRATCH, hash_pair, hit_data, shade
+from .shading import CHUNK, SCRATCH, hit_data, shade
 
 #: error_model="numpy": IEEE divisions, as the NumPy reference's (numba's
 #: default checks every division for zero and raises).

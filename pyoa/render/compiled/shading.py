@@ -45,6 +45,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..._numba.hashes import hash_pair
 from ..bsdf import DIFFUSE, MIRROR
 from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR
 from .bsdf import evaluate, evaluate_diffuse, sample, sample_diffuse
@@ -102,24 +103,6 @@ def hit_data(scene, em_prob, reach):
         np.asarray(scene.triangles, np.float64)[:, 0], scene.normals, scene.emission,
         np.asarray(em_prob) / np.asarray(scene.areas), reach, np.asarray(m.kind, np.float64)[mat],
         np.asarray(m.alpha)[mat], np.asarray(m.color)[mat]]), dtype=np.float64)
-
-
-@njit(**_INLINE)
-def _mix32(x):
-    """Wellons' lowbias32 on a uint32 held in an int64 (as pyoa.reference.mix32)."""
-    x ^= x >> 16
-    x = (x * 0x7FEB352D) & 0xFFFFFFFF
-    x ^= x >> 15
-    x = (x * 0x846CA68B) & 0xFFFFFFFF
-    x ^= x >> 16
-    return x
-
-
-@njit(**_INLINE)
-def hash_pair(a, b, key):
-    """``mix32(b ^ mix32(a ^ key))``, never 0 (as pyoa.reference.hash_pair)."""
-    h = _mix32((b & 0xFFFFFFFF) ^ _mix32((a & 0xFFFFFFFF) ^ key))
-    return key if h == 0 else h
 
 
 @njit(**_INLINE)
