@@ -19,7 +19,7 @@ every row once each, beside, in the same round:
   ``mitsuba`` is importable (otherwise the report says it was skipped), in
   both tracing modes (its ``embree_use_robust_intersections``; its default
   is false), one subprocess per round and mode;
-- the **Embree floor** of each tracing mode: a 64 x 64 render's own rays
+- the **Embree floor** of each tracing mode: a 96 x 96 render's own rays
   replayed through the shipped tracing path (Embree packets called from
   numba) on two threads, i.e. what the renderer would reach if shading
   were free.
