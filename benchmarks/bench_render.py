@@ -199,15 +199,8 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     scratch, lanes = np.empty(csh.SCRATCH), np.empty(csh.CHUNK, np.int64)
     cam_scratch = np.empty(ccam.SCRATCH)
     for start in range(0, len(pixel), size_w):
-        stop = min(start + size_w, len(pixel))
-        m = stop - start
-        ci.camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
-                       cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, cam_scratch, w.o,
-                       w.d)
-        w.lane[:m] = np.arange(start, stop)
-        w.beta[:m] = 1.0
-        w.prev_pdf[:m] = 0.0
-        w.prev_delta[:m] = True
+        m = min(size_w, len(pixel) - start)
+        ci.start_paths(cam, ps, pixel, x, u, start, m, cam_scratch, w)
         live = m
         for depth in range(1, ps.max_depth + 1):
             if live == 0:

@@ -5,7 +5,7 @@
 (camera, Embree, shading). This probe runs the same loop, a wavefront of
 :data:`~pyoa.render.compiled.integrator.WAVEFRONT` paths at a time, as a
 compiled driver of its own that calls the renderer's own functions
-(``camera_rays``, ``embree.intersect``/``occluded`` and every step of
+(``start_paths``: the camera rays, ``embree.intersect``/``occluded``, every step of
 ``shading.shade``: ``gather``, ``head``, ``emit_and_choose``, ...,
 ``survivors``, ``emission_only``) with a monotonic clock read between
 them, so no Python runs between the steps and each number is the step
@@ -41,7 +41,7 @@ from pyoa.render.integrator import RR_KEY, U32, hash_pair  # noqa: E402
 from pyoa.render.render import plan, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
-STEPS = ("camera", "start paths", "closest hits", "gather", "head", "emit_and_choose", "light_directions",
+STEPS = ("camera rays", "closest hits", "gather", "head", "emit_and_choose", "light_directions",
          "evaluate_others", "shadow_rays", "emit_shadows", "sample_lobes", "sample_others", "new_rays", "survivors",
          "shadow rays (Embree)", "add_visible", "emission_only")
 SIZE, SPP = 64, 121
@@ -57,19 +57,9 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
     now = ci._now
     for start in range(0, n, size):
         m = min(size, n - start)
-        stop = start + m
         a = now(clock, ts)
-        ccam.camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
-                         cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, cs, w.o, w.d)
-        b = now(clock, ts)
-        spent[0] += b - a
-        for j in range(m):
-            w.lane[j] = start + j
-            w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = 1.0, 1.0, 1.0
-            w.prev_pdf[j] = 0.0
-            w.prev_delta[j] = True
-        a = now(clock, ts)
-        spent[1] += a - b
+        ci.start_paths(cam, ps, pixel, x, u, start, m, cs, w)
+        spent[0] += now(clock, ts) - a
         live = m
         for depth in range(1, ps.max_depth + 1):
             if live == 0:
@@ -77,10 +67,10 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
             a = now(clock, ts)
             embree.intersect(tr.scene, tr.hit, tr.packet, w.o[:live], w.d[:live], w.prim, w.t)
             b = now(clock, ts)
-            spent[2] += b - a
+            spent[1] += b - a
             if depth == ps.max_depth:
                 sh.emission_only(live, depth, ps.mis, sc, w, radiance)
-                spent[16] += now(clock, ts) - b
+                spent[15] += now(clock, ts) - b
                 break
             nn, live, shadows = live, 0, 0
             extend = ps.mis or depth < ps.max_depth - 1
@@ -102,7 +92,7 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
                 shadows = sh.emit_shadows(h, F, lanes, w, shadows)
                 t[7] = now(clock, ts)
                 for k in range(7):
-                    spent[3 + k] += t[k + 1] - t[k]
+                    spent[2 + k] += t[k + 1] - t[k]
                 if not extend:
                     continue
                 sh.sample_lobes(h, F)
@@ -114,15 +104,15 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
                 live = sh.survivors(h, depth, ps.rr_depth, F, lanes, sample_index, rr_key, w, live)
                 t[11] = now(clock, ts)
                 for k in range(7, 11):
-                    spent[3 + k] += t[k + 1] - t[k]
+                    spent[2 + k] += t[k + 1] - t[k]
             a = now(clock, ts)
             if shadows:
                 embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],
                                 w.sh_dist[:shadows], w.free)
             b = now(clock, ts)
-            spent[14] += b - a
+            spent[13] += b - a
             ci.add_visible(shadows, w, radiance)
-            spent[15] += now(clock, ts) - b
+            spent[14] += now(clock, ts) - b
 
 
 def probe(name: str, robust: bool) -> str:

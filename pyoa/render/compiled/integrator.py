@@ -133,6 +133,23 @@ def new_wavefront(size):
                      np.empty((size, 3)), np.empty(size, np.bool_))
 
 
+@njit(**_INLINE)
+def start_paths(cam, ps, pixel, x, u, start, m, scratch, w):
+    """The first ``m`` entries of ``w`` become the paths ``start .. start +
+    m - 1`` of the batch (``pixel``, sampler rows ``x``, filter offsets
+    ``u``: as :func:`render_paths`) at their camera rays (:func:`camera_rays`,
+    ``scratch`` its :data:`~pyoa.render.compiled.camera.SCRATCH` values):
+    throughput 1, and the emission their rays see counted fully."""
+    stop = start + m
+    camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
+                cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, scratch, w.o, w.d)
+    for j in range(m):
+        w.lane[j] = start + j
+        w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = 1.0, 1.0, 1.0
+        w.prev_pdf[j] = 0.0
+        w.prev_delta[j] = True  # as a delta lobe: no MIS weight for what a camera ray sees
+
+
 @njit(**_JIT)
 def add_visible(m, w, radiance):
     """Add the contributions of the shadow rays that reached their emitter."""
@@ -213,15 +230,8 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, cl
     spent[0] += _now(clock, ts) - t0
     for start in range(0, n, size):
         m = min(size, n - start)
-        stop = start + m
         t0 = _now(clock, ts)
-        camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
-                    cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, cam_scratch, w.o, w.d)
-        for j in range(m):
-            w.lane[j] = start + j
-            w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = 1.0, 1.0, 1.0
-            w.prev_pdf[j] = 0.0
-            w.prev_delta[j] = True  # camera rays count emission fully
+        start_paths(cam, ps, pixel, x, u, start, m, cam_scratch, w)
         t1 = _now(clock, ts)
         spent[0] += t1 - t0
         live = m
