@@ -408,8 +408,7 @@ def cmd_reference(args) -> int:
     p = _plan(scene, args, args.sampler, args.pass_spp)
     _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
     key = reference_key(scene, p, pass_spp=args.pass_spp, passes=passes, seed=args.seed)
-    # the client's shading, not each worker's $PYOA_SHADING: one reference
-    settings = p.settings.replace(shading=p.shading)
+    settings = p.worker_settings()
     meta = describe(scene, p, kind="reference", command=_command(args), passes=passes, pass_spp=args.pass_spp)
     meta["spp"] = args.spp  # the reference's samples per pixel; the plan's is one pass's
     with engine(args.workers, args.scheduler) as eng:

@@ -175,11 +175,13 @@ class Plan:
     nbytes: int  # the render's peak with the scene's tracer (render_bytes + scene_bytes)
     max_bytes: int
     settings: RenderSettings  # as asked (None where the scene's value applies)
+    shading: str  # the shading the render uses (resolve_shading of the settings')
 
-    @property
-    def shading(self) -> str:
-        """The shading the render uses (:func:`resolve_shading` of the settings')."""
-        return resolve_shading(self.settings.shading)
+    def worker_settings(self) -> RenderSettings:
+        """The settings with the shading resolved here, for renders handed to
+        other processes: every worker renders this process's shading, not
+        its own ``$PYOA_SHADING`` (one image, whatever the workers' setup)."""
+        return self.settings.replace(shading=self.shading)
 
 
 def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | None = None, **changes) -> Plan:
@@ -189,6 +191,7 @@ def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | Non
     rendering: every error a render can raise on its arguments is raised
     here, before anything large is allocated."""
     s = RenderSettings.of(settings, **changes)
+    shading = resolve_shading(s.shading)
     limit = resolve_max_bytes(s.max_bytes)
     width, height = image_size(scene, s.width, s.height, limit)
     depth = _count("max_depth", s.max_depth, scene.max_depth, MAX_DEPTH)
@@ -196,8 +199,6 @@ def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | Non
     batch_paths = _count("batch_paths", s.batch_paths)
     if threads is not None:
         threads = _count("threads", threads)
-    if s.shading is not None:
-        resolve_shading(s.shading)
     cam = scene.camera
     layout = Layout(max_depth=depth, mis=scene.mis, lens=cam.aperture > 0,
                     time=bool(np.any(np.asarray(cam.motion) != 0)), first=s.first)
@@ -212,7 +213,8 @@ def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | Non
     fix = (f"render a scene of fewer triangles (its {len(scene.triangles)} triangles take {format_bytes(traced)} "
            "to trace)" if 2 * traced > nbytes else "render fewer pixels or samples")
     check_memory(nbytes, f"a {width} x {height} render at {smp.spp} spp ({smp.dims} dims)", limit, fix)
-    return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit, settings=s)
+    return Plan(width=width, height=height, layout=layout, sampler=smp, nbytes=nbytes, max_bytes=limit, settings=s,
+                shading=shading)
 
 
 def _sub_range(name: str, r, n: int, what: str) -> range:

@@ -89,9 +89,8 @@ def render_on(eng, scene, settings: RenderSettings | None = None, /, *, progress
     settings = RenderSettings.of(settings, **changes)
     if eng.client is None:
         return render(scene, settings, progress=progress)
-    # the client's shading, not each worker's $PYOA_SHADING: one image
     p = plan(scene, settings)
-    settings = settings.replace(shading=p.shading)
+    settings = p.worker_settings()
     src = source_of(scene)
     tiles = tile_ranges(p.width * p.height, p.sampler.spp, eng.slots)
     threads = eng.task_threads()
