@@ -42,7 +42,7 @@ from pyoa.render.render import plan, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
 STEPS = ("camera rays", "closest hits", "gather", "head", "emit_and_choose", "light_directions",
-         "evaluate_others", "shadow_rays", "emit_shadows", "sample_lobes", "sample_others", "new_rays", "survivors",
+         "sample_lobes", "other_kinds", "shadow_rays", "emit_shadows", "new_rays", "survivors",
          "shadow rays (Embree)", "add_visible", "emission_only")
 SIZE, SPP = 64, 121
 
@@ -70,7 +70,7 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
             spent[1] += b - a
             if depth == ps.max_depth:
                 sh.emission_only(live, depth, ps.mis, sc, w, radiance)
-                spent[15] += now(clock, ts) - b
+                spent[14] += now(clock, ts) - b
                 break
             nn, live, shadows = live, 0, 0
             extend = ps.mis or depth < ps.max_depth - 1
@@ -85,34 +85,32 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
                 t[3] = now(clock, ts)
                 sh.light_directions(h, F)
                 t[4] = now(clock, ts)
-                sh.evaluate_others(h, F)
+                if extend:
+                    sh.sample_lobes(h, F)
                 t[5] = now(clock, ts)
-                sh.shadow_rays(h, ps.mis, F)
+                sh.other_kinds(h, extend, F)
                 t[6] = now(clock, ts)
-                shadows = sh.emit_shadows(h, F, lanes, w, shadows)
+                sh.shadow_rays(h, ps.mis, F)
                 t[7] = now(clock, ts)
-                for k in range(7):
-                    spent[2 + k] += t[k + 1] - t[k]
-                if not extend:
-                    continue
-                sh.sample_lobes(h, F)
+                shadows = sh.emit_shadows(h, F, lanes, w, shadows)
                 t[8] = now(clock, ts)
-                sh.sample_others(h, F)
-                t[9] = now(clock, ts)
-                sh.new_rays(h, F)
+                if extend:
+                    sh.new_rays(h, F)
+                    t[9] = now(clock, ts)
+                    live = sh.survivors(h, depth, ps.rr_depth, F, lanes, sample_index, rr_key, w, live)
+                else:
+                    t[9] = t[8]
                 t[10] = now(clock, ts)
-                live = sh.survivors(h, depth, ps.rr_depth, F, lanes, sample_index, rr_key, w, live)
-                t[11] = now(clock, ts)
-                for k in range(7, 11):
+                for k in range(10):
                     spent[2 + k] += t[k + 1] - t[k]
             a = now(clock, ts)
             if shadows:
                 embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],
                                 w.sh_dist[:shadows], w.free)
             b = now(clock, ts)
-            spent[13] += b - a
+            spent[12] += b - a
             ci.add_visible(shadows, w, radiance)
-            spent[14] += now(clock, ts) - b
+            spent[13] += now(clock, ts) - b
 
 
 def probe(name: str, robust: bool) -> str:

@@ -266,6 +266,7 @@ def test_lane_loops_vectorize():
     C = rng.random(cam.SCRATCH)
     calls = {"head": (sh, sh.CHUNK, 2, True, F), "light_directions": (sh, sh.CHUNK, F),
              "shadow_rays": (sh, sh.CHUNK, True, F), "sample_lobes": (sh, sh.CHUNK, F), "new_rays": (sh, sh.CHUNK, F),
+             "ggx_evaluate": (sh, sh.CHUNK, F), "ggx_sample": (sh, sh.CHUNK, F),
              "_rays": (cam, cam.LANES, True, True, 64, 48, 0.5, 0.4, tuple(rng.random(9)), (1.0, 2.0, 3.0), 0.1, 2.0,
                        (0.1, 0.2, 0.3), C)}
     for name, (module, *args) in calls.items():
@@ -282,12 +283,61 @@ def test_scratch_rows_do_not_overlap():
     from the next row's start, and the scratch holds them all."""
     from pyoa.render.compiled import shading as sh
 
-    sizes_and_imports = ("CHUNK", "ROW", "SCRATCH", "HIT_FIELDS", "DIFFUSE", "MIRROR", "RR_KEY")
+    sizes_and_imports = ("CHUNK", "ROW", "SCRATCH", "HIT_FIELDS", "DIFFUSE", "MIRROR", "GGX", "RR_KEY")
     rows = sorted(v for k, v in vars(sh).items()
                   if k.isupper() and not k.startswith("_") and isinstance(v, int) and k not in sizes_and_imports)
     assert rows == [k * sh.ROW for k in range(len(rows))]
     assert sh.ROW >= sh.CHUNK and (sh.ROW * 8) % 4096 != 0 and rows[-1] + sh.ROW <= sh.SCRATCH
     assert sh.CB - sh.V0X == (sh.HIT_FIELDS - 1) * sh.ROW  # gather copies hit_data's row into V0X .. CB
+
+
+@pytest.mark.parametrize("extend", [True, False])
+def test_ggx_lanes_are_the_per_point_bsdf(extend):
+    """other_kinds shades the GGX lanes of a chunk packed into rows of their
+    own, in a vectorized loop: each GGX lane gets, bit for bit, what the
+    per-point evaluate and sample (which mirror the reference) give it,
+    grazing and below-the-surface directions and the warps' corners
+    included, and the other lanes keep what light_directions and
+    sample_lobes wrote (the sample only when the path goes on)."""
+    from pyoa.render.bsdf import DIFFUSE, GGX, MIRROR
+    from pyoa.render.compiled import shading as sh
+
+    rng = np.random.default_rng(11)
+    h = sh.CHUNK
+    F = np.full(sh.SCRATCH, np.nan)
+    row = lambda r: F[r:r + h]  # noqa: E731
+    kind = rng.choice([DIFFUSE, MIRROR, GGX], size=h, p=[0.4, 0.2, 0.4]).astype(np.float64)
+    row(sh.KIND)[:] = kind
+    for r in (sh.CR, sh.CG, sh.CB):
+        row(r)[:] = rng.random(h)
+    row(sh.ALPHA)[:] = rng.choice([1e-4, 0.05, 0.3, 1.0], size=h)
+    wo = _directions(rng, h)
+    wo[-8:, 2] = -np.abs(wo[-8:, 2])  # below the surface: the sample's guard
+    wi = rng.normal(size=(h, 3))
+    wi /= np.linalg.norm(wi, axis=1)[:, None]
+    for r, v in zip((sh.WOX, sh.WOY, sh.WOZ, sh.IX, sh.IY, sh.IZ), (*wo.T, *wi.T)):
+        row(r)[:] = v
+    u = rng.random((h, 2))
+    u[:5] = [[0.5, 0.5], [0.0, 0.0], [0.5, 0.0], [0.0, 0.5], [np.nextafter(1, 0)] * 2]
+    row(sh.BSDF_U)[:], row(sh.BSDF_V)[:] = u.T
+    evaluated = (sh.FR, sh.FG, sh.FB, sh.PDF_B)
+    sampled = (sh.NIX, sh.NIY, sh.NIZ, sh.WR, sh.WG, sh.WB, sh.PDF, sh.DELTA)
+    for r in evaluated:
+        row(r)[:] = rng.random(h)  # as light_directions would leave them
+    sh.sample_lobes(h, F)
+    before = F.copy()
+    sh.other_kinds(h, extend, F)
+    for k in np.flatnonzero(kind == GGX):
+        args = (GGX, *(F[r + k] for r in (sh.CR, sh.CG, sh.CB, sh.ALPHA, sh.WOX, sh.WOY, sh.WOZ)))
+        want = cb.evaluate(*args, *wi[k])
+        assert [F[r + k] for r in evaluated] == list(want), k
+        ix, iy, iz, wr, wg, wb, pdf, delta = cb.sample(*args, *u[k])
+        want = [ix, iy, iz, wr, wg, wb, pdf, float(delta)] if extend else [before[r + k] for r in sampled]
+        assert [F[r + k] for r in sampled] == want, k
+    assert np.count_nonzero(kind == GGX) > 50 and np.any(wo[kind == GGX, 2] < 0)
+    others = np.flatnonzero(kind != GGX)
+    for r in (*evaluated, *sampled):
+        assert np.array_equal(F[r + others], before[r + others])
 
 
 @pytest.mark.parametrize("name", ["cornell", "deep"])

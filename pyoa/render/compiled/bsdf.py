@@ -60,11 +60,11 @@ def ggx_sample_vndf(ox, oy, oz, alpha, u0, u1):
     vn = max(math.sqrt(vx * vx + vy * vy + vz * vz), _TINY)
     vx, vy, vz = vx / vn, vy / vn, vz / vn
     lensq = vx * vx + vy * vy
-    if lensq > 0.0:
-        inv = 1.0 / math.sqrt(lensq)
-        t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
-    else:
-        t1x, t1y, t1z = 1.0, 0.0, 0.0
+    # selects rather than branches (as every function here that a lane loop
+    # calls): the same values, and the loop vectorizes
+    has = lensq > 0.0
+    inv = 1.0 / math.sqrt(lensq)  # inf where lensq is 0, and not used there
+    t1x, t1y, t1z = -vy * inv if has else 1.0, vx * inv if has else 0.0, 0.0
     # t2 = vh x t1
     t2x = vy * t1z - vz * t1y
     t2y = vz * t1x - vx * t1z
@@ -81,9 +81,8 @@ def ggx_sample_vndf(ox, oy, oz, alpha, u0, u1):
     nz = p1 * t1z + p2 * t2z + p3 * vz
     ex, ey, ez = alpha * nx, alpha * ny, max(0.0, nz)
     norm = math.sqrt(ex * ex + ey * ey + ez * ez)
-    if norm > _TINY:
-        return ex / norm, ey / norm, ez / norm
-    return 0.0, 0.0, 1.0
+    ok = norm > _TINY
+    return ex / norm if ok else 0.0, ey / norm if ok else 0.0, ez / norm if ok else 1.0
 
 
 @njit(**_JIT)
@@ -100,18 +99,19 @@ def sample_diffuse(cr, cg, cb, u0, u1):
 
 @njit(**_JIT)
 def sample_ggx(cr, cg, cb, alpha, ox, oy, oz, u0, u1):
-    """The GGX conductor's sample (visible normals): ``(wi x, y, z, weight r, g, b, pdf)``."""
+    """The GGX conductor's sample (visible normals): ``(wi x, y, z, weight r,
+    g, b, pdf)``, free of branches so that a loop over lanes vectorizes
+    (:func:`pyoa.render.compiled.shading.ggx_sample`)."""
     a = max(alpha, ALPHA_MIN)
     hx, hy, hz = ggx_sample_vndf(ox, oy, oz, a, u0, u1)
     c = 2.0 * (ox * hx + oy * hy + oz * hz)
     dx, dy, dz = c * hx - ox, c * hy - oy, c * hz - oz
     dn = max(math.sqrt(dx * dx + dy * dy + dz * dz), _TINY)
     dx, dy, dz = dx / dn, dy / dn, dz / dn
-    if dz > 0.0:
-        fr, fg, fb, p = ggx_eval(cr, cg, cb, a, ox, oy, oz, dx, dy, dz)
-        if p > 0.0 and math.isfinite(p):
-            return dx, dy, dz, fr / p, fg / p, fb / p, p
-    return dx, dy, dz, 0.0, 0.0, 0.0, 0.0
+    # evaluated for every lane (where dz <= 0 its values are not used), then selected
+    fr, fg, fb, p = ggx_eval(cr, cg, cb, a, ox, oy, oz, dx, dy, dz)
+    ok = (dz > 0.0) & (p > 0.0) & (abs(p) < math.inf)
+    return dx, dy, dz, fr / p if ok else 0.0, fg / p if ok else 0.0, fb / p if ok else 0.0, p if ok else 0.0
 
 
 @njit(**_JIT)

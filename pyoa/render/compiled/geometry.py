@@ -38,17 +38,16 @@ def sin_cos(x):
 def cos_sin_turn(u):
     """``(cos 2 pi u, sin 2 pi u)`` for ``u`` in ``[0, 1]``: the nearest
     quarter turn ``k / 4`` is exact, the rest ``2 pi (u - k / 4)`` lies in
-    ``[-pi/4, pi/4]`` (:func:`sin_cos`), and the quarter turns swap and negate."""
+    ``[-pi/4, pi/4]`` (:func:`sin_cos`), and the quarter turns swap and
+    negate. Written with selects, the quarter ``q = k mod 4`` kept a float
+    (exact for whole numbers), so that a loop over lanes vectorizes (AVX2
+    has no packed conversion of doubles to 64-bit integers)."""
     k = math.floor(4.0 * u + 0.5)
     s, c = sin_cos(2.0 * math.pi * (u - 0.25 * k))
-    q = int(k) & 3
-    if q == 0:
-        return c, s
-    if q == 1:
-        return -s, c
-    if q == 2:
-        return -c, -s
-    return s, -c
+    q = k - 4.0 * math.floor(0.25 * k)
+    cq = c if q == 0.0 else (-s if q == 1.0 else (-c if q == 2.0 else s))
+    sq = s if q == 0.0 else (c if q == 1.0 else (-s if q == 2.0 else -c))
+    return cq, sq
 
 
 @njit(**_JIT)

@@ -13,21 +13,24 @@ For each chunk it
 3. adds the emission to the paths' radiance and chooses each lane's point on
    an emitter (:func:`emit_and_choose`: a binary search per lane, scalar);
 4. computes the next-event directions and the Lambertian values
-   (:func:`light_directions`), the other BSDFs one lane at a time
-   (:func:`evaluate_others`), then the shadow rays and what they carry
-   (:func:`shadow_rays`), and compacts them for Embree (:func:`emit_shadows`);
-5. samples the Lambertian and mirror lobes (:func:`sample_lobes`), the other
-   BSDFs one lane at a time (:func:`sample_others`), makes the new rays
-   (:func:`new_rays`), and plays Russian roulette while compacting the
-   surviving lanes to the front of the wavefront (:func:`survivors`).
+   (:func:`light_directions`) and samples the Lambertian and mirror lobes
+   (:func:`sample_lobes`) for every lane, then both again for the GGX lanes,
+   packed into rows of their own (:func:`other_kinds`, :func:`ggx_evaluate`,
+   :func:`ggx_sample`);
+5. makes the shadow rays and what they carry (:func:`shadow_rays`) and
+   compacts them for Embree (:func:`emit_shadows`);
+6. makes the new rays (:func:`new_rays`), and plays Russian roulette while
+   compacting the surviving lanes to the front of the wavefront
+   (:func:`survivors`).
 
 The last bounce (the path's ``max_depth``-th segment, after which no light
 sample or new ray follows) only adds the emission its rays see:
 :func:`emission_only` does that one entry at a time for the few rays that
 hit an emitter's front, without the scratch.
 
-Steps 2, 4 and 5's lane loops contain no branches that depend on a lane
-(selects instead) and touch only the scratch, laid out as one flat array
+The lane loops of steps 2, 4, 5 and 6 (all but the packing and the
+compactions) contain no branches that depend on a lane (selects instead)
+and touch only the scratch, laid out as one flat array
 with rows :data:`CHUNK` apart: with the distance between rows a compile-time
 constant, LLVM proves that the rows do not overlap and vectorizes the loops
 without run-time alias checks (with a 2-D array whose row stride is only
@@ -46,9 +49,9 @@ import numpy as np
 from numba import njit
 
 from ..._numba.hashes import hash_pair
-from ..bsdf import DIFFUSE, MIRROR
+from ..bsdf import ALPHA_MIN, DIFFUSE, GGX, MIRROR
 from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR
-from .bsdf import evaluate, evaluate_diffuse, sample, sample_diffuse
+from .bsdf import evaluate, evaluate_diffuse, ggx_eval, sample, sample_diffuse, sample_ggx
 from .emitters import sample_emitter
 from .geometry import frame
 
@@ -59,7 +62,7 @@ _JIT = dict(nogil=True, cache=True, error_model="numpy")
 _INLINE = dict(_JIT, inline="always")
 
 #: Lanes shaded together: the rows of the scratch array. 256 lanes of its
-#: 105 rows are 217 KiB, within a core's L2 cache.
+#: 129 rows are 266 KiB, within a core's L2 cache.
 CHUNK = 256
 #: Distance between the scratch's rows: CHUNK plus one cache line, because rows a
 #: power of two apart fall into the same few sets of the L1 cache and evict
@@ -80,10 +83,12 @@ ROW = CHUNK + 8
  # the shadow ray and what it carries
  SH_OK, SH_OX, SH_OY, SH_OZ, SH_DX, SH_DY, SH_DZ, SH_SEG, SH_R, SH_G, SH_B,
  # the BSDF sample (local direction, weight, pdf, delta) and the new ray
- NIX, NIY, NIZ, WR, WG, WB, PDF, DELTA, ALIVE, NBR, NBG, NBB, NOX, NOY, NOZ, NDX, NDY, NDZ) = (
-    k * ROW for k in range(105))
+ NIX, NIY, NIZ, WR, WG, WB, PDF, DELTA, ALIVE, NBR, NBG, NBB, NOX, NOY, NOZ, NDX, NDY, NDZ,
+ # the GGX lanes, packed to the front (other_kinds): which lane, what their BSDF reads, what it gives
+ G_K, G_CR, G_CG, G_CB, G_ALPHA, G_OX, G_OY, G_OZ, G_IX, G_IY, G_IZ, G_U, G_V,
+ G_FR, G_FG, G_FB, G_PDF_B, G_NIX, G_NIY, G_NIZ, G_WR, G_WG, G_WB, G_PDF) = (k * ROW for k in range(129))
 #: Length of the scratch array: one ROW past the last row.
-SCRATCH = NDZ + ROW
+SCRATCH = G_PDF + ROW
 #: The per-triangle values :func:`gather` copies, in the order of the rows
 #: ``V0X .. CB`` (:func:`hit_data` makes them).
 HIT_FIELDS = 16
@@ -252,7 +257,7 @@ def light_directions(h, F):
     """For each lane (vectorized): the unit direction ``w`` to its point on an
     emitter, the distance, the cosine there, ``w`` in the shading frame and
     the Lambertian ``(f_cos, pdf)`` of it (the other BSDFs:
-    :func:`evaluate_others`)."""
+    :func:`other_kinds`)."""
     for k in range(h):
         px, py, pz = F[PX + k], F[PY + k], F[PZ + k]
         vx, vy, vz = F[QX + k] - px, F[QY + k] - py, F[QZ + k] - pz
@@ -271,15 +276,79 @@ def light_directions(h, F):
 
 
 @njit(**_JIT)
-def evaluate_others(h, F):
-    """``(f_cos, pdf)`` of the next-event direction for the lanes whose BSDF
-    is neither Lambertian nor a mirror, one lane at a time (:func:`evaluate`)."""
+def ggx_evaluate(g, F):
+    """The next-event ``(f_cos, pdf)`` of the ``g`` packed GGX lanes
+    (vectorized; :func:`~pyoa.render.compiled.bsdf.ggx_eval`, zero where a
+    direction lies below the surface, as
+    :func:`~pyoa.render.compiled.bsdf.evaluate`)."""
+    for j in range(g):
+        oz, iz = F[G_OZ + j], F[G_IZ + j]
+        fr, fg, fb, pdf = ggx_eval(F[G_CR + j], F[G_CG + j], F[G_CB + j], max(F[G_ALPHA + j], ALPHA_MIN),
+                                   F[G_OX + j], F[G_OY + j], oz, F[G_IX + j], F[G_IY + j], iz)
+        lit = not ((oz <= 0.0) | (iz <= 0.0))  # as evaluate's test, NaN included
+        F[G_FR + j], F[G_FG + j] = fr if lit else 0.0, fg if lit else 0.0
+        F[G_FB + j], F[G_PDF_B + j] = fb if lit else 0.0, pdf if lit else 0.0
+
+
+@njit(**_JIT)
+def ggx_sample(g, F):
+    """The BSDF sample of the ``g`` packed GGX lanes (vectorized;
+    :func:`~pyoa.render.compiled.bsdf.sample_ggx`)."""
+    for j in range(g):
+        (F[G_NIX + j], F[G_NIY + j], F[G_NIZ + j], F[G_WR + j], F[G_WG + j], F[G_WB + j],
+         F[G_PDF + j]) = sample_ggx(F[G_CR + j], F[G_CG + j], F[G_CB + j], F[G_ALPHA + j], F[G_OX + j],
+                                    F[G_OY + j], F[G_OZ + j], F[G_U + j], F[G_V + j])
+
+
+@njit(**_JIT)
+def other_kinds(h, extend, F):
+    """The next-event ``(f_cos, pdf)`` and (``extend``) the BSDF sample of the
+    lanes whose BSDF is neither Lambertian nor a mirror, written over what
+    :func:`light_directions` and :func:`sample_lobes` wrote for them.
+
+    GGX lanes: their arithmetic is long and they are few (``deep`` and
+    ``dof7d``: one box of steel), so their inputs are packed to the front of
+    rows of their own (scalar), shaded there in vectorized loops
+    (:func:`ggx_evaluate`, :func:`ggx_sample`) and copied back (scalar):
+    about half the time of shading them one at a time (``deep``,
+    docs/performance.md). Where ``wo`` lies below the surface the sample is
+    :func:`sample_lobes`' (as :func:`~pyoa.render.compiled.bsdf.sample`'s);
+    a GGX sample is never a delta. A kind with no lane form (a new BSDF,
+    until it gets one) is shaded one lane at a time by the per-point
+    :func:`~pyoa.render.compiled.bsdf.evaluate` and
+    :func:`~pyoa.render.compiled.bsdf.sample`."""
+    g = 0
     for k in range(h):
         kind = F[KIND + k]
-        if kind != DIFFUSE and kind != MIRROR:
+        if kind == GGX:
+            F[G_K + g] = k
+            F[G_CR + g], F[G_CG + g], F[G_CB + g], F[G_ALPHA + g] = F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k]
+            F[G_OX + g], F[G_OY + g], F[G_OZ + g] = F[WOX + k], F[WOY + k], F[WOZ + k]
+            F[G_IX + g], F[G_IY + g], F[G_IZ + g] = F[IX + k], F[IY + k], F[IZ + k]
+            F[G_U + g], F[G_V + g] = F[BSDF_U + k], F[BSDF_V + k]
+            g += 1
+        elif kind != DIFFUSE and kind != MIRROR:
             F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = evaluate(
                 np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k], F[WOZ + k],
                 F[IX + k], F[IY + k], F[IZ + k])
+            if extend:
+                ix, iy, iz, wr, wg, wb, pdf, delta = sample(
+                    np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k],
+                    F[WOZ + k], F[BSDF_U + k], F[BSDF_V + k])
+                F[NIX + k], F[NIY + k], F[NIZ + k] = ix, iy, iz
+                F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = wr, wg, wb, pdf
+                F[DELTA + k] = 1.0 if delta else 0.0
+    if g == 0:
+        return
+    ggx_evaluate(g, F)
+    if extend:
+        ggx_sample(g, F)
+    for j in range(g):
+        k = np.int64(F[G_K + j])
+        F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = F[G_FR + j], F[G_FG + j], F[G_FB + j], F[G_PDF_B + j]
+        if extend and not F[G_OZ + j] <= 0.0:  # as sample's test, NaN included
+            F[NIX + k], F[NIY + k], F[NIZ + k] = F[G_NIX + j], F[G_NIY + j], F[G_NIZ + j]
+            F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = F[G_WR + j], F[G_WG + j], F[G_WB + j], F[G_PDF + j]
 
 
 @njit(**_JIT)
@@ -335,7 +404,7 @@ def emit_shadows(h, F, lanes, w, shadows):
 def sample_lobes(h, F):
     """The BSDF sample of each lane (vectorized) for the Lambertian and the
     mirror lobes, chosen by a select (:func:`sample_diffuse`; a mirror
-    reflects ``wo``); the other kinds: :func:`sample_others`."""
+    reflects ``wo``); the other kinds: :func:`other_kinds`."""
     for k in range(h):
         ox, oy, oz = F[WOX + k], F[WOY + k], F[WOZ + k]
         cr, cg, cb = F[CR + k], F[CG + k], F[CB + k]
@@ -350,21 +419,6 @@ def sample_lobes(h, F):
         F[WB + k] = 0.0 if below else (cb if mirror else wb)
         F[PDF + k] = 0.0 if below else (0.0 if mirror else pdf)
         F[DELTA + k] = 1.0 if mirror else 0.0
-
-
-@njit(**_JIT)
-def sample_others(h, F):
-    """The BSDF sample of the lanes whose BSDF is neither Lambertian nor a
-    mirror, one lane at a time (:func:`sample`)."""
-    for k in range(h):
-        kind = F[KIND + k]
-        if kind != DIFFUSE and kind != MIRROR:
-            ix, iy, iz, wr, wg, wb, pdf, delta = sample(
-                np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k], F[WOZ + k],
-                F[BSDF_U + k], F[BSDF_V + k])
-            F[NIX + k], F[NIY + k], F[NIZ + k] = ix, iy, iz
-            F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = wr, wg, wb, pdf
-            F[DELTA + k] = 1.0 if delta else 0.0
 
 
 @njit(**_JIT)
@@ -482,13 +536,12 @@ def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance, F, lanes):
         head(h, depth, ps.mis, F)
         emit_and_choose(h, sc, F, lanes, radiance)
         light_directions(h, F)
-        evaluate_others(h, F)
+        if extend:
+            sample_lobes(h, F)
+        other_kinds(h, extend, F)
         shadow_rays(h, ps.mis, F)
         shadows = emit_shadows(h, F, lanes, w, shadows)
-        if not extend:
-            continue
-        sample_lobes(h, F)
-        sample_others(h, F)
-        new_rays(h, F)
-        live = survivors(h, depth, ps.rr_depth, F, lanes, sample_index, rr_key, w, live)
+        if extend:
+            new_rays(h, F)
+            live = survivors(h, depth, ps.rr_depth, F, lanes, sample_index, rr_key, w, live)
     return live, shadows
