@@ -291,6 +291,41 @@ def test_scratch_rows_do_not_overlap():
     assert sh.CB - sh.V0X == (sh.HIT_FIELDS - 1) * sh.ROW  # gather copies hit_data's row into V0X .. CB
 
 
+@pytest.mark.parametrize("n_emitters", [1, 2, 3, 7, 8, 33])
+def test_emitter_choice_is_the_reference(n_emitters):
+    """The compiled emitter sample (an inline binary search of the power
+    CDF) picks the reference's triangle (NumPy's searchsorted) and point for
+    every u, at the CDF's own values and their neighbours included, with
+    emitters of equal and of very unequal power."""
+    import types
+
+    from pyoa.render.compiled.emitters import sample_emitter
+    from pyoa.render.emitters import Emitters
+
+    rng = np.random.default_rng(n_emitters)
+    T = n_emitters + 3
+    tris = rng.normal(size=(T, 3, 3)).astype(np.float32)
+    normals = rng.normal(size=(T, 3))
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    emission = np.zeros((T, 3))
+    emitters = rng.permutation(T)[:n_emitters]
+    emission[emitters] = rng.choice([1.0, 1.0, 1e-6, 40.0], size=(n_emitters, 1)) * rng.uniform(0.5, 1, (n_emitters, 3))
+    scene = types.SimpleNamespace(emitters=np.sort(emitters), areas=rng.uniform(0.1, 2.0, T), emission=emission,
+                                  triangles=tris, normals=normals)
+    em = Emitters(scene)
+    c = em.cdf
+    u0 = np.concatenate([rng.random(500), c, np.nextafter(c, 0), np.nextafter(c, 2), [0.0, np.nextafter(1, 0)]])
+    u0 = np.clip(u0, 0.0, np.nextafter(1, 0))
+    u = np.stack([u0, rng.random(len(u0))], axis=1)
+    tri, p, nrm, pdf = em.sample(u)
+    verts = np.ascontiguousarray(tris, dtype=np.float64)
+    for i in range(len(u)):
+        got = sample_emitter(em.index, em.cdf, em.prob, verts, normals, scene.areas, u[i, 0], u[i, 1])
+        assert got[0] == tri[i], (i, u[i])
+        np.testing.assert_allclose(got[1:4], p[i], rtol=1e-15, atol=1e-15)
+        assert list(got[4:7]) == list(nrm[i]) and got[7] == pdf[i]
+
+
 @pytest.mark.parametrize("extend", [True, False])
 def test_ggx_lanes_are_the_per_point_bsdf(extend):
     """other_kinds shades the GGX lanes of a chunk packed into rows of their
