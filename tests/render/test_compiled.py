@@ -342,12 +342,14 @@ def test_ggx_lanes_are_the_per_point_bsdf(extend):
     F = np.full(sh.SCRATCH, np.nan)
     row = lambda r: F[r:r + h]  # noqa: E731
     kind = rng.choice([DIFFUSE, MIRROR, GGX], size=h, p=[0.4, 0.2, 0.4]).astype(np.float64)
+    kind[:6] = GGX  # the warps' corners and the normal incidence below are GGX lanes
     row(sh.KIND)[:] = kind
     for r in (sh.CR, sh.CG, sh.CB):
         row(r)[:] = rng.random(h)
     row(sh.ALPHA)[:] = rng.choice([1e-4, 0.05, 0.3, 1.0], size=h)
     wo = _directions(rng, h)
     wo[-8:, 2] = -np.abs(wo[-8:, 2])  # below the surface: the sample's guard
+    wo[5] = [0.0, 0.0, 1.0]  # normal incidence: the visible-normal frame's fallback tangent
     wi = rng.normal(size=(h, 3))
     wi /= np.linalg.norm(wi, axis=1)[:, None]
     for r, v in zip((sh.WOX, sh.WOY, sh.WOZ, sh.IX, sh.IY, sh.IZ), (*wo.T, *wi.T)):
@@ -364,11 +366,12 @@ def test_ggx_lanes_are_the_per_point_bsdf(extend):
     sh.other_kinds(h, extend, F)
     for k in np.flatnonzero(kind == GGX):
         args = (GGX, *(F[r + k] for r in (sh.CR, sh.CG, sh.CB, sh.ALPHA, sh.WOX, sh.WOY, sh.WOZ)))
+        bits = lambda values: np.array(values, np.float64).view(np.uint64)  # noqa: E731 - -0.0 is not 0.0
         want = cb.evaluate(*args, *wi[k])
-        assert [F[r + k] for r in evaluated] == list(want), k
+        assert np.array_equal(bits([F[r + k] for r in evaluated]), bits(want)), k
         ix, iy, iz, wr, wg, wb, pdf, delta = cb.sample(*args, *u[k])
         want = [ix, iy, iz, wr, wg, wb, pdf, float(delta)] if extend else [before[r + k] for r in sampled]
-        assert [F[r + k] for r in sampled] == want, k
+        assert np.array_equal(bits([F[r + k] for r in sampled]), bits(want)), k
     assert np.count_nonzero(kind == GGX) > 50 and np.any(wo[kind == GGX, 2] < 0)
     others = np.flatnonzero(kind != GGX)
     for r in (*evaluated, *sampled):

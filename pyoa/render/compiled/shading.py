@@ -28,8 +28,9 @@ sample or new ray follows) only adds the emission its rays see:
 :func:`emission_only` does that one entry at a time for the few rays that
 hit an emitter's front, without the scratch.
 
-The lane loops of steps 2, 4, 5 and 6 (all but the packing and the
-compactions) contain no branches that depend on a lane (selects instead)
+The lane loops of steps 2, 4, 5 and 6 (all but the packing of GGX lanes,
+the per-point fallback for other kinds and the compactions) contain no
+branches that depend on a lane (selects instead)
 and touch only the scratch, laid out as one flat array
 with rows :data:`CHUNK` apart: with the distance between rows a compile-time
 constant, LLVM proves that the rows do not overlap and vectorizes the loops
@@ -313,7 +314,9 @@ def other_kinds(h, extend, F):
     about half the time of shading them one at a time (``deep``,
     docs/performance.md). Where ``wo`` lies below the surface the sample is
     :func:`sample_lobes`' (as :func:`~pyoa.render.compiled.bsdf.sample`'s);
-    a GGX sample is never a delta. A kind with no lane form (a new BSDF,
+    a GGX sample is never a delta. So when ``extend``, :func:`sample_lobes`
+    must have run on the chunk first (:func:`shade` runs it just before).
+    A kind with no lane form (a new BSDF,
     until it gets one) is shaded one lane at a time by the per-point
     :func:`~pyoa.render.compiled.bsdf.evaluate` and
     :func:`~pyoa.render.compiled.bsdf.sample`."""
