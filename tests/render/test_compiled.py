@@ -364,9 +364,9 @@ def test_ggx_lanes_are_the_per_point_bsdf(extend):
     sh.sample_lobes(h, F)
     before = F.copy()
     sh.other_kinds(h, extend, F)
+    bits = lambda values: np.array(values, np.float64).view(np.uint64)  # noqa: E731 - -0.0 is not 0.0
     for k in np.flatnonzero(kind == GGX):
         args = (GGX, *(F[r + k] for r in (sh.CR, sh.CG, sh.CB, sh.ALPHA, sh.WOX, sh.WOY, sh.WOZ)))
-        bits = lambda values: np.array(values, np.float64).view(np.uint64)  # noqa: E731 - -0.0 is not 0.0
         want = cb.evaluate(*args, *wi[k])
         assert np.array_equal(bits([F[r + k] for r in evaluated]), bits(want)), k
         ix, iy, iz, wr, wg, wb, pdf, delta = cb.sample(*args, *u[k])

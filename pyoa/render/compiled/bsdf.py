@@ -137,6 +137,16 @@ def evaluate_diffuse(cr, cg, cb, oz, iz):
 
 
 @njit(**_JIT)
+def evaluate_ggx(cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz):
+    """The GGX lobe's ``(f_cos r, g, b, pdf)``, zero where ``wo`` or ``wi``
+    lies below the surface, free of branches (the lane loop:
+    :func:`pyoa.render.compiled.shading.ggx_evaluate`)."""
+    f_r, f_g, f_b, pdf = ggx_eval(cr, cg, cb, max(alpha, ALPHA_MIN), ox, oy, oz, ix, iy, iz)
+    lit = not ((oz <= 0.0) | (iz <= 0.0))  # as evaluate's test, NaN included
+    return f_r if lit else 0.0, f_g if lit else 0.0, f_b if lit else 0.0, pdf if lit else 0.0
+
+
+@njit(**_JIT)
 def evaluate(kind, cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz):
     """``(f_cos r, g, b, pdf)``: :func:`pyoa.render.bsdf.evaluate` for one point."""
     if oz <= 0.0 or iz <= 0.0 or kind == MIRROR:
@@ -144,5 +154,5 @@ def evaluate(kind, cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz):
     if kind == DIFFUSE:
         return evaluate_diffuse(cr, cg, cb, oz, iz)
     if kind == GGX:
-        return ggx_eval(cr, cg, cb, max(alpha, ALPHA_MIN), ox, oy, oz, ix, iy, iz)
+        return evaluate_ggx(cr, cg, cb, alpha, ox, oy, oz, ix, iy, iz)
     return 0.0, 0.0, 0.0, 0.0

@@ -50,9 +50,9 @@ import numpy as np
 from numba import njit
 
 from ..._numba.hashes import hash_pair
-from ..bsdf import ALPHA_MIN, DIFFUSE, GGX, MIRROR
+from ..bsdf import DIFFUSE, GGX, MIRROR
 from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR
-from .bsdf import evaluate, evaluate_diffuse, ggx_eval, sample, sample_diffuse, sample_ggx
+from .bsdf import evaluate, evaluate_diffuse, evaluate_ggx, sample, sample_diffuse, sample_ggx
 from .emitters import sample_emitter
 from .geometry import frame
 
@@ -279,16 +279,11 @@ def light_directions(h, F):
 @njit(**_JIT)
 def ggx_evaluate(g, F):
     """The next-event ``(f_cos, pdf)`` of the ``g`` packed GGX lanes
-    (vectorized; :func:`~pyoa.render.compiled.bsdf.ggx_eval`, zero where a
-    direction lies below the surface, as
-    :func:`~pyoa.render.compiled.bsdf.evaluate`)."""
+    (vectorized; :func:`~pyoa.render.compiled.bsdf.evaluate_ggx`)."""
     for j in range(g):
-        oz, iz = F[G_OZ + j], F[G_IZ + j]
-        fr, fg, fb, pdf = ggx_eval(F[G_CR + j], F[G_CG + j], F[G_CB + j], max(F[G_ALPHA + j], ALPHA_MIN),
-                                   F[G_OX + j], F[G_OY + j], oz, F[G_IX + j], F[G_IY + j], iz)
-        lit = not ((oz <= 0.0) | (iz <= 0.0))  # as evaluate's test, NaN included
-        F[G_FR + j], F[G_FG + j] = fr if lit else 0.0, fg if lit else 0.0
-        F[G_FB + j], F[G_PDF_B + j] = fb if lit else 0.0, pdf if lit else 0.0
+        F[G_FR + j], F[G_FG + j], F[G_FB + j], F[G_PDF_B + j] = evaluate_ggx(
+            F[G_CR + j], F[G_CG + j], F[G_CB + j], F[G_ALPHA + j], F[G_OX + j], F[G_OY + j], F[G_OZ + j],
+            F[G_IX + j], F[G_IY + j], F[G_IZ + j])
 
 
 @njit(**_JIT)
