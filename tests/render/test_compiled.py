@@ -378,6 +378,37 @@ def test_ggx_lanes_are_the_per_point_bsdf(extend):
         assert np.array_equal(F[r + others], before[r + others])
 
 
+def test_a_kind_without_lanes_is_shaded_per_point():
+    """other_kinds' promise for a BSDF added without a lane form: its lanes
+    get what the per-point evaluate and sample give (kind 3, which the
+    per-point functions shade as they shade any kind they do not name),
+    not the Lambertian values light_directions and sample_lobes left."""
+    from pyoa.render.bsdf import DIFFUSE, KINDS
+    from pyoa.render.compiled import shading as sh
+
+    new_kind = float(max(KINDS.values()) + 1)
+    rng = np.random.default_rng(3)
+    h = 64
+    F = rng.random(sh.SCRATCH)
+    F[sh.KIND:sh.KIND + h] = np.where(np.arange(h) % 2 == 0, new_kind, float(DIFFUSE))
+    wo, wi = _directions(rng, h), _directions(rng, h)
+    for r, v in zip((sh.WOX, sh.WOY, sh.WOZ, sh.IX, sh.IY, sh.IZ), (*wo.T, *wi.T)):
+        F[r:r + h] = v
+    sh.sample_lobes(h, F)
+    before = F.copy()
+    sh.other_kinds(h, True, F)
+    for k in range(h):
+        args = (int(F[sh.KIND + k]), *(F[r + k] for r in (sh.CR, sh.CG, sh.CB, sh.ALPHA, sh.WOX, sh.WOY, sh.WOZ)))
+        got_eval = [F[r + k] for r in (sh.FR, sh.FG, sh.FB, sh.PDF_B)]
+        got_sample = [F[r + k] for r in (sh.NIX, sh.NIY, sh.NIZ, sh.WR, sh.WG, sh.WB, sh.PDF, sh.DELTA)]
+        if k % 2:  # Lambertian: untouched
+            assert got_eval == [before[r + k] for r in (sh.FR, sh.FG, sh.FB, sh.PDF_B)]
+            continue
+        assert got_eval == list(cb.evaluate(*args, *wi[k]))
+        ix, iy, iz, wr, wg, wb, pdf, delta = cb.sample(*args, F[sh.BSDF_U + k], F[sh.BSDF_V + k])
+        assert got_sample == [ix, iy, iz, wr, wg, wb, pdf, float(delta)]
+
+
 @pytest.mark.parametrize("name", ["cornell", "deep"])
 @pytest.mark.parametrize("mis", [True, False])
 def test_the_last_bounce_adds_what_the_full_shading_would(name, mis):
