@@ -64,7 +64,7 @@ import numpy as np  # noqa: E402
 
 import peers  # noqa: E402
 from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
-from pyoa.render.render import BATCH_PATHS, render  # noqa: E402
+from pyoa.render.render import BATCH_PATHS, _queue_bounds, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
 SCENES = ("cornell", "dof7d", "bounce9d", "deep")
@@ -317,10 +317,18 @@ print(json.dumps({"status": "ok", "baseline_kib": base, "peak_kib": status_kib("
 """
 
 
+#: Bytes per camera path in flight of docs/performance.md's stated bound
+#: ("Render memory"), by shading.
+STATED_PATH_BYTES = {"numba": 512, "numpy": 1536}
+
+
 def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batch_paths: int) -> dict:
     """The render's resident-set peak above its warmed-up baseline, in a fresh
-    process, beside the image's own bytes and the batch working set this
-    implies per camera path (``threads x batch_paths`` paths are in flight)."""
+    process, beside the image's own bytes, the batch working set this implies
+    per camera path (``threads x batch_paths`` paths are in flight), and the
+    stated bound: ``B`` bytes per path in flight (:data:`STATED_PATH_BYTES`),
+    the float32 sampler values made ahead of the workers (at most
+    ``_queue_bounds(threads)[1]`` batches) and the image."""
     argv = [scene_name, args.sampler, shading, args.spp, *size, args.max_depth, batch_paths]
     proc = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, *map(str, argv)], capture_output=True, text=True,
                           timeout=1800)
@@ -333,11 +341,16 @@ def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batc
     in_flight = min(threads * per_batch, size[0] * size[1] * args.spp)
     above = (res["peak_kib"] - res["baseline_kib"]) * 1024
     image = 12 * size[0] * size[1]
+    batches = -(-size[0] * size[1] * args.spp // per_batch)
+    workers = min(threads, batches)
+    ahead = min(batches, _queue_bounds(workers)[1]) * per_batch * 4 * res["dims"]
+    bound = workers * per_batch * STATED_PATH_BYTES[res["shading"]] + ahead + image
     entry.update(status="ok", threads=threads, baseline_bytes=res["baseline_kib"] * 1024, above_bytes=above,
                  image_bytes=image, paths_in_flight=in_flight,
-                 bytes_per_path=(above - image) / in_flight)
+                 bytes_per_path=(above - image) / in_flight, samples_ahead_bytes=ahead, bound_bytes=bound)
     log(f"  memory {scene_name} {shading} {size[0]}x{size[1]} batch {batch_paths}: "
-        f"{above / 2**20:.1f} MiB above baseline ({entry['bytes_per_path']:.0f} B per path in flight)")
+        f"{above / 2**20:.1f} MiB above baseline ({entry['bytes_per_path']:.0f} B per path in flight; "
+        f"stated bound {bound / 2**20:.1f} MiB)")
     return entry
 
 
@@ -528,17 +541,22 @@ def memory_markdown(rows: list[dict]) -> list[str]:
     lines = ["## Peak memory", "",
              "Resident-set peak of the render above the warmed-up process (a fresh process per row; "
              "`/proc/self/status` VmHWM after resetting it), the image's own bytes (float32 RGB) and the rest per "
-             "camera path in flight (threads x batch paths):", "",
-             "| scene | shading | size | batch paths | paths in flight | peak above baseline | image | per path in flight |",
-             "|---|---|---|---:|---:|---:|---:|---:|"]
+             "camera path in flight (threads x batch paths), and the stated bound of docs/performance.md "
+             "(\"Render memory\"): B per path in flight (512 B compiled, 1.5 KiB NumPy), the float32 sampler values "
+             "made ahead of the workers (at most that many batches' worth) and the image:", "",
+             "| scene | shading | size | batch paths | paths in flight | peak above baseline | image "
+             "| per path in flight | sampler values made ahead, at most | stated bound | within |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
         if r["status"] != "ok":
             lines.append(f"| {r['scene']} | {r['shading']} | {r['size'][0]} x {r['size'][1]} | {r['batch_paths']:,} | "
-                         f"failed: {r['reason']} | | | |")
+                         f"failed: {r['reason']} | | | | | | |")
             continue
         lines.append(f"| {r['scene']} | {r['shading']} | {r['size'][0]} x {r['size'][1]} | {r['batch_paths']:,} | "
                      f"{r['paths_in_flight']:,} | {r['above_bytes'] / 2**20:.1f} MiB | {r['image_bytes'] / 2**20:.2f} MiB "
-                     f"| {r['bytes_per_path']:,.0f} B |")
+                     f"| {r['bytes_per_path']:,.0f} B | {r['samples_ahead_bytes'] / 2**20:.1f} MiB "
+                     f"| {r['bound_bytes'] / 2**20:.1f} MiB "
+                     f"| {'yes' if r['above_bytes'] <= r['bound_bytes'] else '**no**'} |")
     return lines
 
 

@@ -2,9 +2,12 @@
 
 The image is the per-pixel mean of ``spp`` camera paths. Pixels are processed
 in batches of whole pixels (every sample of a pixel in one batch): the
-sampler produces the batch's values in one bulk call, the integrator traces
-them, and batches run on a thread pool (Embree and NumPy release the GIL).
-The result does not depend on the batch size or the number of threads.
+sampler produces the values of :data:`SAMPLE_GROUP` consecutive batches in
+one bulk call, on threads of its own that run ahead of the render workers,
+the integrator traces each batch, and batches run on a thread pool (Embree
+and NumPy release the GIL). The result does not depend on the batch size,
+the grouping or the number of threads: a value depends only on its pixel,
+sample and dimension.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import os
 import sys
 import time
 import warnings
+from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
@@ -38,6 +42,16 @@ PATH_BYTES = 1024
 #: (its entry in the list of batches and the tuple in it).
 PIXEL_BYTES = 12
 BATCH_BYTES = 128
+#: Batches whose sampler values one sampler call makes, and how many such
+#: calls run ahead of the render workers (``SAMPLE_AHEAD`` per worker, on as
+#: many sampling threads as workers). Larger calls cost PoCL less per value,
+#: and samples made before a worker needs them fill the time a worker used
+#: to wait for PoCL's threads: on two cores, renders of the four bundled
+#: scenes took 0.93-0.97 of the time of each worker sampling its own batch,
+#: for 47-117 MiB more memory at the peak (docs/performance.md, "Where
+#: sampling runs"; groups of 4 were no faster and took more).
+SAMPLE_GROUP = 2
+SAMPLE_AHEAD = 1
 #: Most pixels in one image: pixel indices are uint32 (the sampler's pixel seeds).
 MAX_PIXELS = MAX_UINT32 + 1
 #: Memory of a loaded scene per triangle while it is traced: its own arrays
@@ -125,14 +139,28 @@ def resolve_max_bytes(max_bytes: int | str | None) -> int:
 def render_bytes(width: int, height: int, spp: int, dims: int, *, batch_paths: int = BATCH_PATHS,
                  threads: int | None = None) -> int:
     """Bytes :func:`render` needs at its peak: the image, the list of batches,
-    and each worker's batch of camera paths in flight (every sample of a pixel
-    is in one batch, so a batch holds at least ``spp`` paths)."""
+    each worker's batch of camera paths in flight (every sample of a pixel
+    is in one batch, so a batch holds at least ``spp`` paths), and the
+    float32 sampler values made ahead of the workers (:func:`_queue_bounds`)."""
     n_pixels = width * height
     per_batch = min(max(1, batch_paths // spp), n_pixels)
     n_batches = -(-n_pixels // per_batch)
     workers = max(1, min(threads or os.cpu_count() or 1, n_batches))
     in_flight = workers * per_batch * spp * (PATH_BYTES + 8 * dims)
-    return n_pixels * PIXEL_BYTES + n_batches * BATCH_BYTES + in_flight
+    queued = min(n_batches, _queue_bounds(workers)[1]) * per_batch * spp * 4 * dims
+    return n_pixels * PIXEL_BYTES + n_batches * BATCH_BYTES + in_flight + queued
+
+
+def _queue_bounds(workers: int) -> tuple[int, int]:
+    """``(tracing, samples)``: the most batches :func:`render` hands to its
+    ``workers`` at once (running or waiting for one), and the most batches
+    whose sampler values are alive at once. A batch's values are a view of
+    its group's array, which lives until the last of its batches is traced:
+    the consecutive batches handed out span at most ``ceil(tracing /
+    SAMPLE_GROUP) + 1`` groups (the one being handed out among them), and
+    ``SAMPLE_AHEAD * workers`` more are being sampled."""
+    tracing = workers + 1
+    return tracing, (-(-tracing // SAMPLE_GROUP) + 1 + SAMPLE_AHEAD * workers) * SAMPLE_GROUP
 
 
 def check_memory(nbytes: int, what: str, limit: int, fix: str = "render fewer pixels or samples") -> None:
@@ -338,9 +366,14 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
     first = tile.start
     total = Stats()
 
-    def run(batch):
-        p0, p1 = batch
+    def sample(group):
+        """The sampler values of consecutive batches, made in one call: a view for each batch."""
+        p0, p1 = group[0][0], group[-1][1]
         x = smp.generate(pixels=range(p0, p1), samples=samples).reshape((p1 - p0) * n, smp.dims)
+        return [x[(b0 - p0) * n:(b1 - p0) * n] for b0, b1 in group]
+
+    def trace(batch, x):
+        p0, p1 = batch
         pixel = np.repeat(np.arange(p0, p1), n)
         sample = np.tile(np.arange(samples.start, samples.stop), p1 - p0)
         rad, st = integ.radiance(pixel, sample, x, seed=seed)
@@ -350,6 +383,9 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
         if flat_sums is not None:
             flat_sums[p0 - first:p1 - first] = s
         return st
+
+    def run(batch):
+        return trace(batch, sample([batch])[0])
 
     bar = None
     compiled = None
@@ -375,15 +411,43 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
             what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
             bar = tqdm(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {smp.name} {what}")
     workers = max(1, min(threads or os.cpu_count() or 1, len(batches)))
+
+    def done(batch, future):
+        (p0, p1), st = batch, future.result()
+        total.add(st)
+        if bar is not None:
+            bar.update(p1 - p0)
+        if outer is not None:
+            outer.update(n * (p1 - p0) / (width * height))
+
+    # Sampling runs ahead of tracing, SAMPLE_GROUP batches per sampler call, on threads of its own; at most
+    # _queue_bounds' batches of samples are alive at once (render_bytes counts them).
+    groups = iter([batches[i:i + SAMPLE_GROUP] for i in range(0, len(batches), SAMPLE_GROUP)])
+    most_tracing = _queue_bounds(workers)[0]
+    sampling_pool = ThreadPoolExecutor(workers, thread_name_prefix="pyoa-sample")
+    pool = ThreadPoolExecutor(workers, thread_name_prefix="pyoa-trace")
+    sampled, tracing = deque(), deque()
+
+    def sample_ahead():
+        while len(sampled) < SAMPLE_AHEAD * workers and (group := next(groups, None)) is not None:
+            sampled.append((group, sampling_pool.submit(sample, group)))
+
     try:
-        with ThreadPoolExecutor(workers) as pool:
-            for (p0, p1), st in zip(batches, pool.map(run, batches)):
-                total.add(st)
-                if bar is not None:
-                    bar.update(p1 - p0)
-                if outer is not None:
-                    outer.update(n * (p1 - p0) / (width * height))
+        sample_ahead()
+        while sampled:
+            group, future = sampled.popleft()
+            xs = future.result()
+            sample_ahead()
+            for batch, x in zip(group, xs):
+                while len(tracing) >= most_tracing:
+                    done(*tracing.popleft())
+                tracing.append((batch, pool.submit(trace, batch, x)))
+        while tracing:
+            done(*tracing.popleft())
     finally:
+        # on an error or an interrupt, start nothing new and wait for what runs (it writes into out)
+        for executor in (sampling_pool, pool):
+            executor.shutdown(wait=True, cancel_futures=True)
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - t0
