@@ -158,9 +158,14 @@ def _queue_bounds(workers: int) -> tuple[int, int]:
     its group's array, which lives until the last of its batches is traced:
     the consecutive batches handed out span at most ``ceil(tracing /
     SAMPLE_GROUP) + 1`` groups (the one being handed out among them), and
-    ``SAMPLE_AHEAD * workers`` more are being sampled."""
+    :func:`_groups_ahead` more are being sampled."""
     tracing = workers + 1
-    return tracing, (-(-tracing // SAMPLE_GROUP) + 1 + SAMPLE_AHEAD * workers) * SAMPLE_GROUP
+    return tracing, (-(-tracing // SAMPLE_GROUP) + 1 + _groups_ahead(workers)) * SAMPLE_GROUP
+
+
+def _groups_ahead(workers: int) -> int:
+    """Sampler calls in flight ahead of ``workers`` render workers (at least one: the values have to be made)."""
+    return max(1, SAMPLE_AHEAD * workers)
 
 
 def check_memory(nbytes: int, what: str, limit: int, fix: str = "render fewer pixels or samples") -> None:
@@ -423,13 +428,13 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
     # Sampling runs ahead of tracing, SAMPLE_GROUP batches per sampler call, on threads of its own; at most
     # _queue_bounds' batches of samples are alive at once (render_bytes counts them).
     groups = iter([batches[i:i + SAMPLE_GROUP] for i in range(0, len(batches), SAMPLE_GROUP)])
-    most_tracing = _queue_bounds(workers)[0]
+    most_tracing, ahead = _queue_bounds(workers)[0], _groups_ahead(workers)
     sampling_pool = ThreadPoolExecutor(workers, thread_name_prefix="pyoa-sample")
     pool = ThreadPoolExecutor(workers, thread_name_prefix="pyoa-trace")
     sampled, tracing = deque(), deque()
 
     def sample_ahead():
-        while len(sampled) < SAMPLE_AHEAD * workers and (group := next(groups, None)) is not None:
+        while len(sampled) < ahead and (group := next(groups, None)) is not None:
             sampled.append((group, sampling_pool.submit(sample, group)))
 
     try:

@@ -169,3 +169,12 @@ def test_an_error_in_tracing_ends_the_render_with_it(cornell):
     # the batches not yet started were dropped: far fewer than all of them were traced
     assert slow.calls < BATCHES // 2 and time.perf_counter() - t0 < 60
     assert np.isfinite(render(cornell, **KW, threads=2).image).all()
+
+
+def test_nothing_ahead_still_samples_every_batch(monkeypatch, cornell):
+    """SAMPLE_AHEAD = 0 (no call ahead per worker) still makes one call at a time, not an empty image."""
+    ref = render(cornell, **KW).image.tobytes()
+    monkeypatch.setattr(render_mod, "SAMPLE_AHEAD", 0)
+    rec = Recorder(monkeypatch)
+    assert render(cornell, **KW, threads=2).image.tobytes() == ref
+    assert len(rec.pixels) == -(-BATCHES // render_mod.SAMPLE_GROUP)
