@@ -47,9 +47,11 @@ BATCH_BYTES = 128
 #: many sampling threads as workers). Larger calls cost PoCL less per value,
 #: and samples made before a worker needs them fill the time a worker used
 #: to wait for PoCL's threads: on two cores, renders of the four bundled
-#: scenes took 0.93-0.97 of the time of each worker sampling its own batch,
-#: for 47-117 MiB more memory at the peak (docs/performance.md, "Where
-#: sampling runs"; groups of 4 were no faster and took more).
+#: scenes took 0.93-0.97 of the time of each worker sampling its own batch
+#: (docs/performance.md, "Where sampling runs"; groups of 4 were no faster).
+#: The price is memory: the values of up to ``_queue_bounds(threads)[1]``
+#: batches (10 on two threads) are alive at once, which :func:`render_bytes`
+#: charges.
 SAMPLE_GROUP = 2
 SAMPLE_AHEAD = 1
 #: Most pixels in one image: pixel indices are uint32 (the sampler's pixel seeds).
