@@ -338,6 +338,8 @@ print(json.dumps({"status": "ok", "baseline_kib": base, "peak_kib": status_kib("
 """
 
 
+#: glibc's mmap threshold in the memory children (``MALLOC_MMAP_THRESHOLD_``).
+MMAP_THRESHOLD = 128 * 1024
 #: Bytes per camera path in flight of docs/performance.md's stated bound
 #: ("Render memory"), by shading.
 STATED_PATH_BYTES = {"numba": 512, "numpy": 1536}
@@ -351,8 +353,11 @@ def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batc
     the float32 sampler values made ahead of the workers (at most
     ``_queue_bounds(threads)[1]`` batches) and the image."""
     argv = [scene_name, args.sampler, shading, args.spp, *size, args.max_depth, batch_paths]
+    # glibc's mmap threshold fixed (it grows with every large free by default): every array above 128 KiB is
+    # its own mapping, returned to the OS when freed, so the baseline holds no freed arrays a render could reuse
+    env = dict(os.environ, MALLOC_MMAP_THRESHOLD_=str(MMAP_THRESHOLD))
     proc = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, *map(str, argv)], capture_output=True, text=True,
-                          timeout=1800)
+                          timeout=1800, env=env)
     entry = {"scene": scene_name, "shading": shading, "size": list(size), "batch_paths": batch_paths}
     if proc.returncode != 0:
         return {**entry, "status": "failed", "reason": (proc.stderr.strip().splitlines() or ["?"])[-1]}
@@ -561,7 +566,8 @@ def scene_markdown(cfg: dict, sc: dict) -> list[str]:
 def memory_markdown(rows: list[dict]) -> list[str]:
     lines = ["## Peak memory", "",
              "Resident-set peak of the render above the process warmed up by the same render (a fresh process per "
-             "row; the warm-up's freed heap returned with malloc_trim, then `/proc/self/status` VmHWM reset: the "
+             "row, glibc's mmap threshold fixed at 128 KiB; the warm-up's freed heap returned with malloc_trim, "
+             "then `/proc/self/status` VmHWM reset: the "
              "working set, without a process's one-time costs such as PoCL compiling kernels for new call shapes), "
              "the image's own bytes (float32 RGB) and the rest per "
              "camera path in flight (threads x batch paths), and the stated bound of docs/performance.md "

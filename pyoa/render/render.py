@@ -18,7 +18,7 @@ import sys
 import time
 import warnings
 from collections import deque
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,7 +50,7 @@ BATCH_BYTES = 128
 #: scenes took 0.93-0.97 of the time of each worker sampling its own batch
 #: (docs/performance.md, "Where sampling runs"; groups of 4 were no faster).
 #: The price is memory: the values of up to ``_queue_bounds(threads)[1]``
-#: batches (10 on two threads) are alive at once, which :func:`render_bytes`
+#: batches (12 on two threads) are alive at once, which :func:`render_bytes`
 #: charges.
 SAMPLE_GROUP = 2
 SAMPLE_AHEAD = 1
@@ -157,12 +157,13 @@ def _queue_bounds(workers: int) -> tuple[int, int]:
     """``(tracing, samples)``: the most batches :func:`render` hands to its
     ``workers`` at once (running or waiting for one), and the most batches
     whose sampler values are alive at once. A batch's values are a view of
-    its group's array, which lives until the last of its batches is traced:
-    the consecutive batches handed out span at most ``ceil(tracing /
-    SAMPLE_GROUP) + 1`` groups (the one being handed out among them), and
-    :func:`_groups_ahead` more are being sampled."""
+    its group's array, which lives until the last of its batches is traced.
+    Batches finish in any order, so the unfinished ones may hold ``tracing``
+    groups alive; with the group being handed out and the
+    :func:`_groups_ahead` groups being sampled, that is ``tracing + 1 +
+    ahead`` groups at most."""
     tracing = workers + 1
-    return tracing, (-(-tracing // SAMPLE_GROUP) + 1 + _groups_ahead(workers)) * SAMPLE_GROUP
+    return tracing, (tracing + 1 + _groups_ahead(workers)) * SAMPLE_GROUP
 
 
 def _groups_ahead(workers: int) -> int:
@@ -379,7 +380,10 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
         x = smp.generate(pixels=range(p0, p1), samples=samples).reshape((p1 - p0) * n, smp.dims)
         return [x[(b0 - p0) * n:(b1 - p0) * n] for b0, b1 in group]
 
-    def trace(batch, x):
+    def trace(batch, holder):
+        # the values come in a list emptied here, so that they die with this call: the pool's finished
+        # work item, which keeps its arguments a moment longer, must not keep a group alive (_queue_bounds)
+        x = holder.pop()
         p0, p1 = batch
         pixel = np.repeat(np.arange(p0, p1), n)
         sample = np.tile(np.arange(samples.start, samples.stop), p1 - p0)
@@ -392,7 +396,7 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
         return st
 
     def run(batch):
-        return trace(batch, sample([batch])[0])
+        return trace(batch, sample([batch]))
 
     bar = None
     compiled = None
@@ -433,28 +437,38 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
     most_tracing, ahead = _queue_bounds(workers)[0], _groups_ahead(workers)
     sampling_pool = ThreadPoolExecutor(workers, thread_name_prefix="pyoa-sample")
     pool = ThreadPoolExecutor(workers, thread_name_prefix="pyoa-trace")
-    sampled, tracing = deque(), deque()
+    sampled, tracing = deque(), {}  # groups being sampled; the futures of batches handed out, and their batch
 
     def sample_ahead():
         while len(sampled) < ahead and (group := next(groups, None)) is not None:
             sampled.append((group, sampling_pool.submit(sample, group)))
 
+    def retire():
+        """Wait for the first of the batches handed out to finish (whichever it is: a slow batch must not keep
+        the other workers idle), and count those that did."""
+        finished, _ = wait(tracing, return_when=FIRST_COMPLETED)
+        for future in finished:
+            done(tracing.pop(future), future)
+
     try:
         sample_ahead()
         while sampled:
             group, future = sampled.popleft()
-            xs = future.result()
+            views = future.result()
             sample_ahead()
-            for batch, x in zip(group, xs):
+            for batch in group:
                 while len(tracing) >= most_tracing:
-                    done(*tracing.popleft())
-                tracing.append((batch, pool.submit(trace, batch, x)))
+                    retire()
+                tracing[pool.submit(trace, batch, [views.pop(0)])] = batch
         while tracing:
-            done(*tracing.popleft())
+            retire()
     finally:
-        # on an error or an interrupt, start nothing new and wait for what runs (it writes into out)
+        # on an error or an interrupt: start nothing new in either pool first, then wait for what runs (it
+        # writes into out), so that a second interrupt during the wait cannot leave a pool starting batches
         for executor in (sampling_pool, pool):
-            executor.shutdown(wait=True, cancel_futures=True)
+            executor.shutdown(wait=False, cancel_futures=True)
+        for executor in (sampling_pool, pool):
+            executor.shutdown(wait=True)
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - t0
