@@ -69,7 +69,7 @@ import numpy as np  # noqa: E402
 
 import peers  # noqa: E402
 from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
-from pyoa.render.render import BATCH_PATHS, _queue_bounds, render  # noqa: E402
+from pyoa.render.render import BATCH_PATHS, render, values_ahead_bytes  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
 SCENES = ("cornell", "dof7d", "bounce9d", "deep")
@@ -314,13 +314,12 @@ def _row(scene, shading: str, times: list, res) -> dict:
 # peak memory, in a fresh process per render
 
 _MEMORY_CHILD = MEMORY_CHILD_HELPERS + r"""
-import json, sys
+import ctypes, gc, json, sys
 from pyoa.render.render import render
 from pyoa.render.scene import load
 
 name, sampler, shading = sys.argv[1:4]
 spp, w, h, depth, batch = (int(v) if v != "None" else None for v in sys.argv[4:9])
-import ctypes, gc
 scene = load(name)
 # Warm-up: the same render first, so that the peak measured is the render's working set, not the one-time
 # costs of a process's first render of this shape (PoCL compiles a kernel per sampler call shape, LLVM's
@@ -350,8 +349,8 @@ def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batc
     process, beside the image's own bytes, the batch working set this implies
     per camera path (``threads x batch_paths`` paths are in flight), and the
     stated bound: ``B`` bytes per path in flight (:data:`STATED_PATH_BYTES`),
-    the float32 sampler values made ahead of the workers (at most
-    ``_queue_bounds(threads)[1]`` batches) and the image."""
+    the float32 sampler values made ahead of the workers
+    (:func:`pyoa.render.render.values_ahead_bytes`) and the image."""
     argv = [scene_name, args.sampler, shading, args.spp, *size, args.max_depth, batch_paths]
     # glibc's mmap threshold fixed (it grows with every large free by default): every array above 128 KiB is
     # its own mapping, returned to the OS when freed, so the baseline holds no freed arrays a render could reuse
@@ -369,7 +368,7 @@ def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batc
     image = 12 * size[0] * size[1]
     batches = -(-size[0] * size[1] * args.spp // per_batch)
     workers = min(threads, batches)
-    ahead = min(batches, _queue_bounds(workers)[1]) * per_batch * 4 * res["dims"]
+    ahead = values_ahead_bytes(batches, per_batch, res["dims"], workers)
     bound = workers * per_batch * STATED_PATH_BYTES[res["shading"]] + ahead + image
     entry.update(status="ok", threads=threads, baseline_bytes=res["baseline_kib"] * 1024, above_bytes=above,
                  image_bytes=image, paths_in_flight=in_flight,

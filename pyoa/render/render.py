@@ -149,8 +149,15 @@ def render_bytes(width: int, height: int, spp: int, dims: int, *, batch_paths: i
     n_batches = -(-n_pixels // per_batch)
     workers = max(1, min(threads or os.cpu_count() or 1, n_batches))
     in_flight = workers * per_batch * spp * (PATH_BYTES + 8 * dims)
-    queued = min(n_batches, _queue_bounds(workers)[1]) * per_batch * spp * 4 * dims
+    queued = values_ahead_bytes(n_batches, per_batch * spp, dims, workers)
     return n_pixels * PIXEL_BYTES + n_batches * BATCH_BYTES + in_flight + queued
+
+
+def values_ahead_bytes(n_batches: int, batch_paths: int, dims: int, workers: int) -> int:
+    """Bytes of the float32 sampler values that :func:`render` holds beside
+    its ``workers`` at most: ``_queue_bounds(workers)[1]`` batches of
+    ``batch_paths`` rows (no more than the render's ``n_batches``)."""
+    return min(n_batches, _queue_bounds(workers)[1]) * batch_paths * 4 * dims
 
 
 def _queue_bounds(workers: int) -> tuple[int, int]:
