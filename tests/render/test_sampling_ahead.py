@@ -185,3 +185,34 @@ def test_nothing_ahead_still_samples_every_batch(monkeypatch, cornell):
     rec = Recorder(monkeypatch)
     assert render(cornell, **KW, threads=2).image.tobytes() == ref
     assert len(rec.pixels) == -(-BATCHES // render_mod.SAMPLE_GROUP)
+
+
+def test_a_slow_batch_does_not_hold_up_the_others(cornell):
+    """Batches are counted as they finish, not oldest first: while the first batch waits, the other worker
+    traces far more batches than the render hands out at once (_queue_bounds' first number). Counted
+    oldest-first, the render would stop handing out batches behind the first one, and it would time out."""
+    integ = compiled_integrator(cornell)
+    others_done, lock = threading.Event(), threading.Lock()
+    need = _queue_bounds(2)[0] + 3
+    count = {"calls": 0, "others": 0}
+
+    class FirstWaits:
+        width, height = integ.width, integ.height
+
+        def radiance(self, *args, **kw):
+            with lock:
+                count["calls"] += 1
+                first = count["calls"] == 1
+            if first:
+                if not others_done.wait(60):
+                    raise TimeoutError("the other batches were not handed out while the first one ran")
+                return integ.radiance(*args, **kw)
+            res = integ.radiance(*args, **kw)
+            with lock:
+                count["others"] += 1
+                if count["others"] >= need:
+                    others_done.set()
+            return res
+
+    img = render(cornell, **KW, threads=2, integrator=(FirstWaits(), "numba")).image
+    assert img.tobytes() == render(cornell, **KW).image.tobytes()
