@@ -129,8 +129,13 @@ def probe(name: str, robust: bool) -> str:
     if integ.filter != "box":
         raise SystemExit("the probe renders with the box filter only")
     best = None
+    # one radiance array, zeroed in place: a fresh np.zeros per round maps new pages, and the first write to
+    # each (in add_visible or emit_and_choose) would time the kernel's page faults, which the renderer, whose
+    # batches reuse freed heap memory, mostly does not pay
+    radiance = np.zeros((len(pixel), 3))
     for _ in range(3):
-        spent, radiance = np.zeros(len(STEPS)), np.zeros((len(pixel), 3))
+        spent = np.zeros(len(STEPS))
+        radiance.fill(0.0)
         t0 = time.perf_counter()
         drive(integ._tracer, integ._scene, integ._camera, integ._settings, pixel, sample, x, np.zeros((0, 2)),
               radiance, spent, integ._clock, rr_key, integ.wavefront)
