@@ -69,7 +69,7 @@ import numpy as np  # noqa: E402
 
 import peers  # noqa: E402
 from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
-from pyoa.render.render import BATCH_PATHS, render, values_ahead_bytes  # noqa: E402
+from pyoa.render.render import BATCH_PATHS, batch_layout, render, values_ahead_bytes  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
 SCENES = ("cornell", "dof7d", "bounce9d", "deep")
@@ -362,14 +362,13 @@ def peak_memory(scene_name: str, args, shading: str, size: tuple[int, int], batc
         return {**entry, "status": "failed", "reason": (proc.stderr.strip().splitlines() or ["?"])[-1]}
     res = json.loads(proc.stdout.strip().splitlines()[-1])
     threads = os.cpu_count() or 1
-    per_batch = max(1, batch_paths // args.spp) * args.spp  # whole pixels
-    in_flight = min(threads * per_batch, size[0] * size[1] * args.spp)
+    pixels, batches, workers = batch_layout(size[0] * size[1], args.spp, batch_paths=batch_paths, threads=threads)
+    per_batch = pixels * args.spp  # paths: whole pixels
+    in_flight = workers * per_batch
     above = (res["peak_kib"] - res["baseline_kib"]) * 1024
     image = 12 * size[0] * size[1]
-    batches = -(-size[0] * size[1] * args.spp // per_batch)
-    workers = min(threads, batches)
     ahead = values_ahead_bytes(batches, per_batch, res["dims"], workers)
-    bound = workers * per_batch * STATED_PATH_BYTES[res["shading"]] + ahead + image
+    bound = in_flight * STATED_PATH_BYTES[res["shading"]] + ahead + image
     entry.update(status="ok", threads=threads, baseline_bytes=res["baseline_kib"] * 1024, above_bytes=above,
                  image_bytes=image, paths_in_flight=in_flight,
                  bytes_per_path=(above - image) / in_flight, samples_ahead_bytes=ahead, bound_bytes=bound)

@@ -145,12 +145,21 @@ def render_bytes(width: int, height: int, spp: int, dims: int, *, batch_paths: i
     is in one batch, so a batch holds at least ``spp`` paths), and the
     float32 sampler values made ahead of the workers (:func:`_queue_bounds`)."""
     n_pixels = width * height
-    per_batch = min(max(1, batch_paths // spp), n_pixels)
-    n_batches = -(-n_pixels // per_batch)
-    workers = max(1, min(threads or os.cpu_count() or 1, n_batches))
+    per_batch, n_batches, workers = batch_layout(n_pixels, spp, batch_paths=batch_paths, threads=threads)
     in_flight = workers * per_batch * spp * (PATH_BYTES + 8 * dims)
     queued = values_ahead_bytes(n_batches, per_batch * spp, dims, workers)
     return n_pixels * PIXEL_BYTES + n_batches * BATCH_BYTES + in_flight + queued
+
+
+def batch_layout(n_pixels: int, spp: int, *, batch_paths: int = BATCH_PATHS,
+                 threads: int | None = None) -> tuple[int, int, int]:
+    """``(pixels per batch, batches, workers)`` of a render of ``n_pixels``
+    pixels at ``spp`` samples each: whole pixels per batch, at most
+    ``batch_paths`` paths (at least one pixel), and one worker per thread
+    (``threads`` None: every CPU), no more than there are batches."""
+    per_batch = min(max(1, batch_paths // spp), n_pixels)
+    n_batches = -(-n_pixels // per_batch)
+    return per_batch, n_batches, max(1, min(threads or os.cpu_count() or 1, n_batches))
 
 
 def values_ahead_bytes(n_batches: int, batch_paths: int, dims: int, workers: int) -> int:
