@@ -38,7 +38,7 @@ from pyoa.render.compiled import camera as ccam  # noqa: E402
 from pyoa.render.compiled import integrator as ci  # noqa: E402
 from pyoa.render.compiled import shading as sh  # noqa: E402
 from pyoa.render.integrator import RR_KEY, U32, hash_pair  # noqa: E402
-from pyoa.render.render import plan, render  # noqa: E402
+from pyoa.render.render import pixel_sums, plan, render  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
 STEPS = ("camera rays", "closest hits", "gather", "head", "emit_and_choose", "light_directions",
@@ -142,8 +142,8 @@ def probe(name: str, robust: bool) -> str:
         seconds = time.perf_counter() - t0
         if best is None or seconds < best[0]:
             best = (seconds, spent)
-    # the driver's image is the renderer's (the same per-pixel sum as render())
-    s = np.ascontiguousarray(radiance.reshape(n_pix, smp.spp, 3).transpose(0, 2, 1)).sum(axis=2)
+    # the driver's image is the renderer's (render()'s per-pixel sum)
+    s = pixel_sums(radiance, smp.spp)
     assert (s / smp.spp).astype(np.float32).tobytes() == want.image.reshape(-1, 3).tobytes(), \
         "the probe's driver no longer renders what render_paths does: update it"
     seconds, spent = best

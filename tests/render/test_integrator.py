@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from pyoa.render import integrator as integrator_mod
+from pyoa.render import render as render_mod
 from pyoa.render.layout import Layout
 from pyoa.render.render import render
 from pyoa.render.scene import load
@@ -452,6 +453,23 @@ def test_batches_and_threads_do_not_change_bits(cornell, sampler, spp):
     for batch_paths, threads in ((64, 2), (1000, 1), (1000, 2), (1 << 16, 2), (1, 2)):
         img = render(cornell, **kw, batch_paths=batch_paths, threads=threads).image
         assert img.tobytes() == ref, f"batch_paths={batch_paths} threads={threads}"
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 8, 9, 16, 17, 121, 128, 129, 255, 256, 1000, 1089, 4096, 4097])
+def test_pixel_sums_are_each_pixel_s_contiguous_sums(n):
+    """A pixel's sum is NumPy's sum of its n samples laid out contiguously (pairwise, in an order that depends
+    on n alone), whether it is summed alone or with other pixels: the same bits in any batch."""
+    rng = np.random.default_rng(n)
+    pixels = 5
+    rad = rng.standard_normal((pixels * n, 3)) * rng.choice([1e-9, 1.0, 1e9], (pixels * n, 3))
+    rad[rng.random((pixels * n, 3)) < 0.1] = -0.0
+    rad[-n:, 0] = -0.0  # a pixel whose samples are all -0 (NumPy's sum gives +0 or -0 depending on n)
+    want = np.array([[np.ascontiguousarray(rad[p * n:(p + 1) * n, c]).sum() for c in range(3)] for p in range(pixels)])
+    got = render_mod.pixel_sums(rad, n)
+    assert got.shape == (pixels, 3) and got.dtype == np.float64
+    assert got.tobytes() == want.tobytes()
+    alone = np.concatenate([render_mod.pixel_sums(rad[p * n:(p + 1) * n], n) for p in range(pixels)])
+    assert alone.tobytes() == got.tobytes()
 
 
 def test_seeds_change_the_image_not_its_expectation(tmp_path, cornell):
