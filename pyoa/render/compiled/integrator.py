@@ -219,9 +219,11 @@ def render_paths(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, cl
     ts = np.zeros(2, np.int64)
     rays = 0
     t0 = _now(clock, ts)
-    rr_key = np.empty(n, np.int64)
+    # roulette keys only where a path can reach roulette: a new ray is made at depths below max_depth, and
+    # roulette plays from rr_depth (of the bundled scenes only deep's paths are that long)
+    rr_key = np.empty(n if ps.rr_depth < ps.max_depth else 0, np.int64)
     last, key = -1, 0
-    for i in range(n):
+    for i in range(rr_key.shape[0]):
         if pixel[i] != last:  # a pixel's samples are consecutive: one hash per pixel
             last = pixel[i]
             key = hash_pair(np.int64(ps.seed), last, RR_KEY)
