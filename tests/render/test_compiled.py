@@ -475,14 +475,16 @@ def test_the_last_bounce_adds_what_the_full_shading_would(name, mis):
     """emission_only (the last bounce: emission alone, one entry at a time)
     adds to every path the same bits as gathering the hits and running
     head and emit_and_choose on them: rays from inside the scene in every
-    direction, some from emitters' backs, with random throughputs, previous
-    pdfs and delta flags, at depth 1 and deeper."""
+    direction, some from emitters' backs, at depth 1 (a camera ray's state,
+    shading.path_state) and deeper with random throughputs, previous pdfs
+    and delta flags."""
     from pyoa.render import embree
     from pyoa.render.compiled import shading as sh
     from pyoa.render.layout import Layout
 
     scene = load(name)
-    integ = ci.CompiledIntegrator(scene, Layout(max_depth=3, mis=mis, lens=False, time=False), 8, 8)
+    layout = Layout(max_depth=3, mis=mis, lens=False, time=False)
+    integ = ci.CompiledIntegrator(scene, layout, 8, 8)
     sc, tr = integ._scene, integ._tracer
     ps = integ._settings._replace(mis=mis)
     rng = np.random.default_rng(5)
@@ -498,14 +500,14 @@ def test_the_last_bounce_adds_what_the_full_shading_would(name, mis):
     w.beta[:] = rng.uniform(0, 2, size=(n, 3))
     w.prev_pdf[:] = rng.uniform(0, 3, size=n)
     w.prev_delta[:] = rng.random(n) < 0.3
-    x = np.zeros((n, 1), np.float32)
+    x = np.zeros((n, layout.dims), np.float32)
     for depth in (1, 2, 3):
         fast = np.zeros((n, 3))
         sh.emission_only(n, depth, mis, sc, w, fast)
         full = np.zeros((n, 3))
         F, lanes = np.empty(sh.SCRATCH), np.empty(sh.CHUNK, np.int64)
         for start in range(0, n, sh.CHUNK):
-            h = sh.gather(start, min(start + sh.CHUNK, n), 0, sc, ps, x, w, F, lanes)
+            h = sh.gather(start, min(start + sh.CHUNK, n), depth, sc, ps, x, w, F, lanes)
             sh.head(h, depth, mis, F)
             for k in range(h):
                 if F[sh.SEEN + k] != 0.0:

@@ -111,9 +111,9 @@ class Wavefront(NamedTuple):
     lane: np.ndarray  # (W,) int64 path (row of x) of each live entry
     o: np.ndarray  # (W, 3) ray origins
     d: np.ndarray  # (W, 3) unit ray directions
-    beta: np.ndarray  # (W, 3) path throughput
-    prev_pdf: np.ndarray  # (W,) solid-angle pdf of the BSDF sample that made the ray
-    prev_delta: np.ndarray  # (W,) bool: that sample was a delta lobe (or the camera's)
+    beta: np.ndarray  # (W, 3) path throughput (from depth 2: shading.path_state)
+    prev_pdf: np.ndarray  # (W,) solid-angle pdf of the BSDF sample that made the ray (from depth 2)
+    prev_delta: np.ndarray  # (W,) bool: that sample was a delta lobe (from depth 2)
     prim: np.ndarray  # (W,) int64 closest hit (-1: none)
     t: np.ndarray  # (W,) its distance
     sh_o: np.ndarray  # (W, 3) shadow rays
@@ -138,16 +138,15 @@ def start_paths(cam, ps, pixel, x, u, start, m, scratch, w):
     """The first ``m`` entries of ``w`` become the paths ``start .. start +
     m - 1`` of the batch (``pixel``, sampler rows ``x``, filter offsets
     ``u``: as :func:`render_paths`) at their camera rays (:func:`camera_rays`,
-    ``scratch`` its :data:`~pyoa.render.compiled.camera.SCRATCH` values):
-    throughput 1, and the emission their rays see counted fully."""
+    ``scratch`` its :data:`~pyoa.render.compiled.camera.SCRATCH` values).
+    Their throughput and previous sample are not stored: the shading takes
+    a camera ray's from :func:`~pyoa.render.compiled.shading.path_state`
+    (storing them took 3-4 ns a path)."""
     stop = start + m
     camera_rays(pixel[start:stop], x[start:stop], u[start:stop], ps.camera_columns, cam.width, cam.height,
                 cam.tan_x, cam.tan_y, cam.rot, cam.pos, cam.aperture, cam.focus, cam.motion, scratch, w.o, w.d)
     for j in range(m):
         w.lane[j] = start + j
-        w.beta[j, 0], w.beta[j, 1], w.beta[j, 2] = 1.0, 1.0, 1.0
-        w.prev_pdf[j] = 0.0
-        w.prev_delta[j] = True  # as a delta lobe: no MIS weight for what a camera ray sees
 
 
 @njit(**_JIT)

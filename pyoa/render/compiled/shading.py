@@ -162,6 +162,19 @@ def russian_roulette(br, bg, bb, key, sample_index, depth):
     return False, br, bg, bb
 
 
+@njit(**_INLINE)
+def path_state(w, i, depth):
+    """``(beta r, g, b, prev_pdf, prev_delta)`` of the wavefront's entry ``i``
+    at ``depth``: its throughput, and the pdf and delta flag of the BSDF
+    sample that made its ray. A camera ray's (depth 1) are not stored
+    (:func:`~pyoa.render.compiled.integrator.start_paths` writes only the
+    rays and lanes): throughput 1, and counted as a delta lobe, so that what
+    a camera ray sees gets no MIS weight."""
+    if depth == 1:
+        return 1.0, 1.0, 1.0, 0.0, True
+    return w.beta[i, 0], w.beta[i, 1], w.beta[i, 2], w.prev_pdf[i], w.prev_delta[i]
+
+
 @njit(**_JIT)
 def gather(start, stop, depth, sc, ps, x, w, F, lanes):
     """Copy the entries ``start .. stop - 1`` of the wavefront ``w`` whose ray
@@ -181,9 +194,10 @@ def gather(start, stop, depth, sc, ps, x, w, F, lanes):
         F[T + h] = w.t[i]
         for c in range(HIT_FIELDS):  # the triangle's row of sc.hit_data: V0X .. CB
             F[V0X + c * ROW + h] = sc.hit_data[tri, c]
-        F[BR + h], F[BG + h], F[BB + h] = w.beta[i, 0], w.beta[i, 1], w.beta[i, 2]
-        F[PREV_PDF + h] = w.prev_pdf[i]
-        F[PREV_DELTA + h] = 1.0 if w.prev_delta[i] else 0.0
+        br, bg, bb, prev_pdf, prev_delta = path_state(w, i, depth)
+        F[BR + h], F[BG + h], F[BB + h] = br, bg, bb
+        F[PREV_PDF + h] = prev_pdf
+        F[PREV_DELTA + h] = 1.0 if prev_delta else 0.0
         F[LIGHT_U + h] = np.float64(x[li, lu]) if lu >= 0 else 0.0
         F[LIGHT_V + h] = np.float64(x[li, lv]) if lv >= 0 else 0.0
         F[BSDF_U + h] = np.float64(x[li, bu]) if bu >= 0 else 0.0
@@ -495,11 +509,12 @@ def emission_only(n, depth, mis, sc, w, radiance):
             continue  # emitters are one-sided
         ti = w.t[i]
         pdf_light = hd[tri, _HIT_PDF] * ti * ti / max(cos_l, 1e-12)
-        wt = emission_weight(depth, mis, pdf_light, w.prev_pdf[i], w.prev_delta[i])
+        br, bg, bb, prev_pdf, prev_delta = path_state(w, i, depth)
+        wt = emission_weight(depth, mis, pdf_light, prev_pdf, prev_delta)
         li = w.lane[i]
-        radiance[li, 0] += w.beta[i, 0] * er * wt
-        radiance[li, 1] += w.beta[i, 1] * eg * wt
-        radiance[li, 2] += w.beta[i, 2] * eb * wt
+        radiance[li, 0] += br * er * wt
+        radiance[li, 1] += bg * eg * wt
+        radiance[li, 2] += bb * eb * wt
 
 
 @njit(**_JIT)
