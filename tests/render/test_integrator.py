@@ -455,7 +455,7 @@ def test_batches_and_threads_do_not_change_bits(cornell, sampler, spp):
         assert img.tobytes() == ref, f"batch_paths={batch_paths} threads={threads}"
 
 
-@pytest.mark.parametrize("n", [1, 2, 7, 8, 9, 16, 17, 121, 128, 129, 255, 256, 1000, 1089, 4096, 4097])
+@pytest.mark.parametrize("n", [1, 2, 7, 8, 9, 16, 17, 121, 128, 129, 255, 256, 1000, 1089, 4096, 4097, 8193, 16385])
 def test_pixel_sums_are_each_pixel_s_contiguous_sums(n):
     """A pixel's sum is NumPy's sum of its n samples laid out contiguously (pairwise, in an order that depends
     on n alone), whether it is summed alone or with other pixels: the same bits in any batch."""
