@@ -48,13 +48,67 @@ SIZE, SPP = 64, 121
 
 
 @njit(nogil=True, error_model="numpy")
-def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr_key, size):
+def shadows_from_rows(scene, fn, width, F, h, lanes, radiance, buf, bits, valid, idx):
+    """A piece of a redesign, measured before it is built (``probe_shadow_rows.py``):
+    the chunk's shadow rays (the lanes ``k < h`` with ``F[SH_OK + k]``) loaded
+    into Embree packets straight from the scratch rows, traced, and the
+    unblocked ones' contributions added to their paths, instead of
+    ``emit_shadows`` copying them into the wavefront for ``embree.occluded``
+    and ``add_visible``. Each path adds its light in the same order, so the
+    image is the same. Returns how many rays."""
+    E = embree
+    j, rays = 0, 0
+    for k in range(h + 1):
+        last = k == h
+        if not last and F[sh.SH_OK + k] != 0.0:
+            # as embree._load: the ray in float32, tfar its segment's length
+            buf[E.ORG_X * width + j] = F[sh.SH_OX + k]
+            buf[E.ORG_Y * width + j] = F[sh.SH_OY + k]
+            buf[E.ORG_Z * width + j] = F[sh.SH_OZ + k]
+            buf[E.TNEAR * width + j] = 0.0
+            buf[E.DIR_X * width + j] = F[sh.SH_DX + k]
+            buf[E.DIR_Y * width + j] = F[sh.SH_DY + k]
+            buf[E.DIR_Z * width + j] = F[sh.SH_DZ + k]
+            buf[E.TIME * width + j] = 0.0
+            buf[E.TFAR * width + j] = np.float32(F[sh.SH_SEG + k])
+            bits[E.MASK * width + j] = 0xFFFFFFFF
+            bits[E.ID * width + j] = 0
+            bits[E.FLAGS * width + j] = 0
+            idx[j] = k
+            j += 1
+        if j == width or (last and j > 0):
+            for q in range(width):
+                valid[q] = -1 if q < j else 0
+            if width == 1:
+                E._ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+            else:
+                E._ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data),
+                          np.uint64(0))
+            for q in range(j):
+                if buf[E.TFAR * width + q] >= 0.0:
+                    li = lanes[idx[q]]
+                    radiance[li, 0] += F[sh.SH_R + idx[q]]
+                    radiance[li, 1] += F[sh.SH_G + idx[q]]
+                    radiance[li, 2] += F[sh.SH_B + idx[q]]
+            rays += j
+            j = 0
+    return rays
+
+
+@njit(nogil=True, error_model="numpy")
+def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr_key, size, rows=False):
+    """``render_paths``' loop with ``shade``'s steps called one by one, the
+    clock read between them (``spent``: seconds per step of :data:`STEPS`).
+    ``rows``: the shadow rays traced from the scratch
+    (:func:`shadows_from_rows`, timed as ``emit_shadows``) instead."""
     n = pixel.shape[0]
     w = ci.new_wavefront(size)
     F, lanes = np.empty(sh.SCRATCH), np.empty(sh.CHUNK, np.int64)
     cs = np.empty(ccam.SCRATCH)
     ts = np.zeros(2, np.int64)
     now = ci._now
+    buf, bits = embree._packet_buffer(tr.packet)
+    valid, idx = np.empty(tr.packet, np.int32), np.empty(tr.packet, np.int64)
     for start in range(0, n, size):
         m = min(size, n - start)
         a = now(clock, ts)
@@ -92,7 +146,11 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
                 t[6] = now(clock, ts)
                 sh.shadow_rays(h, ps.mis, F)
                 t[7] = now(clock, ts)
-                shadows = sh.emit_shadows(h, F, lanes, w, shadows)
+                if rows:
+                    shadows_from_rows(tr.scene, tr.occluded, tr.packet, F, h, lanes, radiance, buf, bits, valid,
+                                      idx)
+                else:
+                    shadows = sh.emit_shadows(h, F, lanes, w, shadows)
                 t[8] = now(clock, ts)
                 if extend:
                     sh.new_rays(h, F)
@@ -113,21 +171,38 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
             spent[13] += now(clock, ts) - b
 
 
-def probe(name: str, robust: bool) -> str:
+def inputs(name: str, robust: bool):
+    """The scene (``robust`` or fast tracing), ``render``'s own result at
+    :data:`SIZE` x :data:`SIZE`, Bose :data:`SPP` spp, one thread (``want``:
+    the image a driver must give, and its integrator), and the driver's
+    arguments from ``pixel`` to ``rr_key`` (the sampler's values made once)."""
     scene = load(name)
     if not robust:
         scene = dataclasses.replace(scene, robust_tracing=False)
     kw = dict(sampler="bose", spp=SPP, width=SIZE, height=SIZE)
     want = render(scene, **kw, threads=1)
     integ = want.integrator[0]
+    if integ.filter != "box":
+        raise SystemExit("the probe renders with the box filter only")
     smp = plan(scene, **kw).sampler
     n_pix = SIZE * SIZE
     x = np.ascontiguousarray(smp.generate(pixels=range(n_pix)).reshape(n_pix * smp.spp, -1))
     pixel = np.repeat(np.arange(n_pix), smp.spp).astype(np.int64)
     sample = np.tile(np.arange(smp.spp), n_pix).astype(np.int64)
     rr_key = hash_pair(U32(smp.seed), pixel.astype(U32), RR_KEY).astype(np.int64)
-    if integ.filter != "box":
-        raise SystemExit("the probe renders with the box filter only")
+    return want, smp, pixel, sample, x, rr_key
+
+
+def check_image(radiance, smp, want, what: str) -> None:
+    """The driver's image is ``render``'s (its per-pixel sum), bit for bit."""
+    s = pixel_sums(radiance, smp.spp)
+    assert (s / smp.spp).astype(np.float32).tobytes() == want.image.reshape(-1, 3).tobytes(), \
+        f"the probe's driver ({what}) no longer renders what render_paths does: update it"
+
+
+def probe(name: str, robust: bool) -> str:
+    want, smp, pixel, sample, x, rr_key = inputs(name, robust)
+    integ = want.integrator[0]
     best = None
     # one radiance array, zeroed in place: a fresh np.zeros per round maps new pages, and the first write to
     # each (in add_visible or emit_and_choose) would time the kernel's page faults, which the renderer, whose
@@ -142,10 +217,7 @@ def probe(name: str, robust: bool) -> str:
         seconds = time.perf_counter() - t0
         if best is None or seconds < best[0]:
             best = (seconds, spent)
-    # the driver's image is the renderer's (render()'s per-pixel sum)
-    s = pixel_sums(radiance, smp.spp)
-    assert (s / smp.spp).astype(np.float32).tobytes() == want.image.reshape(-1, 3).tobytes(), \
-        "the probe's driver no longer renders what render_paths does: update it"
+    check_image(radiance, smp, want, "as shipped")
     seconds, spent = best
     paths = len(pixel)
     order = np.argsort(-spent)
