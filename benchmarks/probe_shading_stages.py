@@ -61,29 +61,14 @@ def shadows_from_rows(scene, fn, width, F, h, lanes, radiance, buf, bits, valid,
     for k in range(h + 1):
         last = k == h
         if not last and F[sh.SH_OK + k] != 0.0:
-            # as embree._load: the ray in float32, tfar its segment's length
-            buf[E.ORG_X * width + j] = F[sh.SH_OX + k]
-            buf[E.ORG_Y * width + j] = F[sh.SH_OY + k]
-            buf[E.ORG_Z * width + j] = F[sh.SH_OZ + k]
-            buf[E.TNEAR * width + j] = 0.0
-            buf[E.DIR_X * width + j] = F[sh.SH_DX + k]
-            buf[E.DIR_Y * width + j] = F[sh.SH_DY + k]
-            buf[E.DIR_Z * width + j] = F[sh.SH_DZ + k]
-            buf[E.TIME * width + j] = 0.0
-            buf[E.TFAR * width + j] = np.float32(F[sh.SH_SEG + k])
-            bits[E.MASK * width + j] = 0xFFFFFFFF
-            bits[E.ID * width + j] = 0
-            bits[E.FLAGS * width + j] = 0
+            E._load_ray(buf, bits, width, j, F[sh.SH_OX + k], F[sh.SH_OY + k], F[sh.SH_OZ + k], F[sh.SH_DX + k],
+                        F[sh.SH_DY + k], F[sh.SH_DZ + k], np.float32(F[sh.SH_SEG + k]))
             idx[j] = k
             j += 1
         if j == width or (last and j > 0):
             for q in range(width):
                 valid[q] = -1 if q < j else 0
-            if width == 1:
-                E._ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
-            else:
-                E._ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data),
-                          np.uint64(0))
+            E._query(scene, fn, width, buf, valid)
             for q in range(j):
                 if buf[E.TFAR * width + q] >= 0.0:
                     li = lanes[idx[q]]

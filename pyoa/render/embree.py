@@ -272,16 +272,17 @@ def _packet_buffer(width):
     return buf, buf.view(np.uint32)
 
 
-@njit(nogil=True, cache=True)
-def _load(buf, bits, width, k, o, d, i, tfar):
-    """Ray ``i`` of the wavefront into lane ``k`` of the packet."""
-    buf[ORG_X * width + k] = o[i, 0]
-    buf[ORG_Y * width + k] = o[i, 1]
-    buf[ORG_Z * width + k] = o[i, 2]
+@njit(nogil=True, cache=True, inline="always")
+def _load_ray(buf, bits, width, k, ox, oy, oz, dx, dy, dz, tfar):
+    """The ray ``o + s d``, ``0 <= s <= tfar``, into lane ``k`` of the packet
+    (float32, as ``embreex``), its hit reset."""
+    buf[ORG_X * width + k] = ox
+    buf[ORG_Y * width + k] = oy
+    buf[ORG_Z * width + k] = oz
     buf[TNEAR * width + k] = 0.0
-    buf[DIR_X * width + k] = d[i, 0]
-    buf[DIR_Y * width + k] = d[i, 1]
-    buf[DIR_Z * width + k] = d[i, 2]
+    buf[DIR_X * width + k] = dx
+    buf[DIR_Y * width + k] = dy
+    buf[DIR_Z * width + k] = dz
     buf[TIME * width + k] = 0.0
     buf[TFAR * width + k] = tfar
     bits[MASK * width + k] = 0xFFFFFFFF
@@ -289,6 +290,16 @@ def _load(buf, bits, width, k, o, d, i, tfar):
     bits[FLAGS * width + k] = 0
     bits[GEOM_ID * width + k] = INVALID_ID
     bits[PRIM_ID * width + k] = INVALID_ID
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _query(scene, fn, width, buf, valid):
+    """Call the query ``fn`` (``rtcIntersect<width>`` or ``rtcOccluded<width>``)
+    on the packet ``buf``, whose lanes ``valid`` marks (-1: a ray, 0: none)."""
+    if width == 1:
+        _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+    else:
+        _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
 
 
 @njit(nogil=True, cache=True)
@@ -299,15 +310,13 @@ def _trace_packet(scene, fn, width, o, d, dist, start, buf, bits, valid):
     m = min(width, o.shape[0] - start)
     for k in range(width):
         if k < m:
-            tfar = np.float32(dist[start + k]) if dist.shape[0] > 0 else np.float32(np.inf)
-            _load(buf, bits, width, k, o, d, start + k, tfar)
+            i = start + k
+            tfar = np.float32(dist[i]) if dist.shape[0] > 0 else np.float32(np.inf)
+            _load_ray(buf, bits, width, k, o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2], tfar)
             valid[k] = -1
         else:
             valid[k] = 0
-    if width == 1:
-        _ccall3(fn, np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
-    else:
-        _ccall4(fn, np.uint64(valid.ctypes.data), np.uint64(scene), np.uint64(buf.ctypes.data), np.uint64(0))
+    _query(scene, fn, width, buf, valid)
     return m
 
 

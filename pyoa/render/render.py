@@ -399,7 +399,7 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
     if integrator is None:
         integrator = (integ, shading)
     n_pixels = len(tile)
-    per_batch = max(1, p.settings.batch_paths // n)
+    per_batch = batch_layout(n_pixels, n, batch_paths=p.settings.batch_paths)[0]
     batches = [(p0, min(p0 + per_batch, tile.stop)) for p0 in range(tile.start, tile.stop, per_batch)]
     out = np.empty((n_pixels, 3), dtype=np.float32)
     flat_sums = None if sums is None else sums.reshape(n_pixels, 3)
@@ -415,9 +415,8 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
     # Every batch's paths in the same order (pixel-major, a pixel's samples consecutive): the pixels' offsets
     # in a batch and the samples' indices are made once for the largest batch (np.repeat and np.tile for each
     # batch took 4 ns a path, about 2 % of a 256 x 256 dof7d render)
-    most = min(per_batch, n_pixels)
-    offsets = np.repeat(np.arange(most), n)
-    sample_indices = np.tile(np.arange(samples.start, samples.stop), most)
+    offsets = np.repeat(np.arange(per_batch), n)
+    sample_indices = np.tile(np.arange(samples.start, samples.stop), per_batch)
 
     def trace(batch, holder):
         # the values come in a list emptied here, so that they die with this call: the pool's finished
