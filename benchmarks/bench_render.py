@@ -66,9 +66,11 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared with the other benchmarks
 
 import numpy as np  # noqa: E402
-
 import peers  # noqa: E402
 from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
+from numba import njit  # noqa: E402
+
+from pyoa.render import embree  # noqa: E402
 from pyoa.render.render import BATCH_PATHS, batch_layout, render, values_ahead_bytes  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
 
@@ -187,11 +189,11 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     ``render_paths`` runs them in one compiled call, and copies each
     wavefront's rays before tracing them."""
     from pyoa.render import embree
-    from pyoa.render.compiled import integrator as ci
-    from pyoa.render.compiled import camera as ccam
-    from pyoa.render.compiled import shading as csh
-    from pyoa.render.integrator import U32, hash_pair, RR_KEY
     from pyoa.render.camera import filter_offsets
+    from pyoa.render.compiled import camera as ccam
+    from pyoa.render.compiled import integrator as ci
+    from pyoa.render.compiled import shading as csh
+    from pyoa.render.integrator import RR_KEY, U32, hash_pair
 
     res = render(scene, sampler=args.sampler, spp=args.spp, width=size[0], height=size[1],
                  max_depth=args.max_depth, threads=1, shading="numba", pixels=range(0, 1))
@@ -231,11 +233,49 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     return calls, len(pixel)
 
 
+@njit(nogil=True)
+def replay_wavefronts(scene, hit, occluded, width, kinds, offsets, o, d, dist):
+    """Trace the wavefronts ``offsets[c] .. offsets[c + 1]`` of the rays
+    ``o``, ``d`` (closest hits where ``kinds[c]`` is 0, shadow rays of
+    length ``dist`` where it is 1) through ``embree.intersect`` and
+    ``embree.occluded``, all in one compiled call that releases the GIL, as
+    ``render_paths`` traces a batch's."""
+    most = 1
+    for c in range(kinds.shape[0]):
+        most = max(most, offsets[c + 1] - offsets[c])
+    prim, t, free = np.empty(most, np.int64), np.empty(most), np.empty(most, np.bool_)
+    for c in range(kinds.shape[0]):
+        a, b = offsets[c], offsets[c + 1]
+        if kinds[c] == 0:
+            embree.intersect(scene, hit, width, o[a:b], d[a:b], prim, t)
+        else:
+            embree.occluded(scene, occluded, width, o[a:b], d[a:b], dist[a:b], free)
+
+
+def pack_calls(calls: list) -> tuple:
+    """``(kinds, offsets, o, d, dist)``: the wavefronts ``calls`` of
+    :func:`record_rays` as contiguous arrays for :func:`replay_wavefronts`."""
+    kinds = np.array([0 if kind == "hit" else 1 for kind, *_ in calls], np.int64)
+    offsets = np.zeros(len(calls) + 1, np.int64)
+    offsets[1:] = np.cumsum([len(o) for _, o, _, _ in calls])
+    o = np.ascontiguousarray(np.concatenate([o for _, o, _, _ in calls]))
+    d = np.ascontiguousarray(np.concatenate([d for _, _, d, _ in calls]))
+    dist = np.concatenate([np.zeros(len(o)) if dist is None else dist for _, o, _, dist in calls])
+    return kinds, offsets, o, d, dist
+
+
 class EmbreeFloor:
     """The tracing path pyoa ships (Embree packets called from numba, the
     scene built as the renderer builds it) alone: the rays of a ``size``
     render of the same scene, sampler, spp and depth (:func:`record_rays`),
     replayed on two threads (each half of the wavefronts) by :meth:`run`.
+    Each thread traces its wavefronts in one compiled call that releases the
+    GIL (:func:`replay_wavefronts`), as a render's worker traces a batch's:
+    no Python runs between two wavefronts. (Until 2026-11-29 the floor
+    called ``embree.intersect`` / ``occluded`` from Python once per
+    wavefront; the threads then queued for the GIL between calls, and that
+    floor was 1.25-1.3x lower on two threads than this one, measured in one
+    process on the Intel Xeon 6/207: docs/performance.md.)
     Its ``paths_per_s`` is the rate at the render's own rays per path: what
     the renderer would reach if shading, sampling and bookkeeping were free."""
 
@@ -243,24 +283,18 @@ class EmbreeFloor:
         from pyoa.render import embree
         from pyoa.render.compiled import integrator as ci
 
-        self.calls, paths = record_rays(scene, args, size)
+        calls, paths = record_rays(scene, args, size)
         self.size, self.packet, self.mode = list(size), ci.packet_width(), tracing(scene)
         self.rtc = embree.Scene(scene.triangles, robust=scene.robust_tracing)
         self.fns = embree.query_addresses(self.packet)
-        self.rays = sum(len(c[1]) for c in self.calls)
+        self.rays = sum(len(c[1]) for c in calls)
         self.rays_per_path = self.rays / paths
+        self.parts = [pack_calls(calls[0::2]), pack_calls(calls[1::2])]
         self.times = []
-        self._replay(self.calls[:4])  # warm
+        self._trace(pack_calls(calls[:4]))  # compile and warm
 
-    def _replay(self, part):
-        from pyoa.render import embree
-
-        for kind, o, d, dist in part:
-            if kind == "hit":
-                embree.intersect(self.rtc.handle, self.fns[0], self.packet, o, d, np.empty(len(o), np.int64),
-                                 np.empty(len(o)))
-            else:
-                embree.occluded(self.rtc.handle, self.fns[1], self.packet, o, d, dist, np.empty(len(o), np.bool_))
+    def _trace(self, part):
+        replay_wavefronts(self.rtc.handle, self.fns[0], self.fns[1], self.packet, *part)
 
     def run(self) -> float:
         """One timed replay on two threads; returns its M paths/s equivalent's rate (paths/s)."""
@@ -268,7 +302,7 @@ class EmbreeFloor:
 
         with ThreadPoolExecutor(2) as pool:
             t0 = time.perf_counter()
-            list(pool.map(self._replay, [self.calls[0::2], self.calls[1::2]]))
+            list(pool.map(self._trace, self.parts))
             self.times.append(time.perf_counter() - t0)
         return self.rays / self.times[-1] / self.rays_per_path
 
@@ -276,7 +310,7 @@ class EmbreeFloor:
         med = statistics.median(self.times)
         return {"size": self.size, "rays": self.rays, "packet": self.packet, "threads": 2, "times_s": self.times,
                 "rays_per_s": self.rays / med, "rays_per_path": self.rays_per_path,
-                "paths_per_s": self.rays / med / self.rays_per_path}
+                "paths_per_s": self.rays / med / self.rays_per_path, "replay": "compiled, one call per thread"}
 
 
 def _render(scene, args, shading: str, **kw):
