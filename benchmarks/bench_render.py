@@ -21,8 +21,9 @@ every row once each, beside, in the same round:
   is false), one subprocess per round and mode;
 - the **Embree floor** of each tracing mode: a 96 x 96 render's own rays
   replayed through the shipped tracing path (Embree packets called from
-  numba) on two threads, i.e. what the renderer would reach if shading
-  were free.
+  numba) on two threads, each tracing its half of the wavefronts in one
+  compiled call as a render's worker traces a batch, i.e. what the renderer
+  would reach if shading were free.
 
 The time covers sample generation, ray tracing and shading, not scene
 loading or image writing. Reported: median, minimum and maximum seconds;
@@ -582,7 +583,8 @@ def scene_markdown(cfg: dict, sc: dict) -> list[str]:
         ratio = f" = {floor['paths_per_s'] / rate:.2f}x Mitsuba ({mode})" if rate else ""
         lines += ["", f"Embree floor, {mode} tracing (the rays of a {floor['size'][0]} x {floor['size'][1]} render "
                       f"of the same scene replayed through the shipped tracing path: {floor['packet']}-wide packets "
-                      f"from numba, {floor['threads']} threads; median of the rounds): "
+                      f"from numba, {floor['threads']} threads, each tracing its wavefronts in one compiled "
+                      f"call; median of the rounds): "
                       f"{floor['rays_per_s'] / 1e6:.2f} M rays/s = {floor['paths_per_s'] / 1e6:.3f} M paths/s at "
                       f"{floor['rays_per_path']:.2f} rays/path{ratio}."]
     profs = [r for r in sc["results"]]
