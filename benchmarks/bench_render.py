@@ -272,11 +272,12 @@ class EmbreeFloor:
     replayed on two threads (each half of the wavefronts) by :meth:`run`.
     Each thread traces its wavefronts in one compiled call that releases the
     GIL (:func:`replay_wavefronts`), as a render's worker traces a batch's:
-    no Python runs between two wavefronts. (Until 2026-11-29 the floor
+    no Python runs between two wavefronts. (Until commit fdffe45 the floor
     called ``embree.intersect`` / ``occluded`` from Python once per
     wavefront; the threads then queued for the GIL between calls, and that
-    floor was 1.25-1.3x lower on two threads than this one, measured in one
-    process on the Intel Xeon 6/207: docs/performance.md.)
+    floor was 1.17-1.31x lower on two threads than this one, measured in one
+    process on the Intel Xeon 6/207: docs/performance.md, "What the floor
+    is".)
     Its ``paths_per_s`` is the rate at the render's own rays per path: what
     the renderer would reach if shading, sampling and bookkeeping were free."""
 
