@@ -183,8 +183,9 @@ def profile_parts(scene, args, shading: str) -> dict:
 
 def record_rays(scene, args, size) -> tuple[list, int]:
     """The rays of a ``size`` render of ``scene`` with the compiled shading:
-    ``(calls, paths)``, ``calls`` a list of ``("hit", o, d, None)`` and
-    ``("occ", o, d, dist)`` wavefronts in the order they are traced. The
+    ``(wavefronts, paths)``, ``wavefronts`` a list of each wavefront's calls
+    in the order they are traced, ``("hit", o, d, None)`` for closest hits
+    and ``("occ", o, d, dist)`` for shadow rays. The
     render runs the compiled integrator's own stages (camera rays,
     ``shading.shade``, ``add_visible``) one wavefront at a time from Python, as
     ``render_paths`` runs them in one compiled call, and copies each
@@ -211,7 +212,7 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     rr_key = hash_pair(U32(p.sampler.seed), pixel.astype(U32), RR_KEY).astype(np.int64)
     radiance = np.zeros((len(pixel), 3))
     tr, sc, cam, ps = integ._tracer, integ._scene, integ._camera, integ._settings
-    calls = []
+    wavefronts = []
     size_w = integ.wavefront
     w = ci.new_wavefront(size_w)
     scratch, lanes = np.empty(csh.SCRATCH), np.empty(csh.CHUNK, np.int64)
@@ -219,6 +220,8 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     for start in range(0, len(pixel), size_w):
         m = min(size_w, len(pixel) - start)
         ci.start_paths(cam, ps, pixel, x, u, start, m, cam_scratch, w)
+        calls = []
+        wavefronts.append(calls)
         live = m
         for depth in range(1, ps.max_depth + 1):
             if live == 0:
@@ -231,7 +234,7 @@ def record_rays(scene, args, size) -> tuple[list, int]:
                 embree.occluded(tr.scene, tr.occluded, tr.packet, w.sh_o[:shadows], w.sh_d[:shadows],
                                 w.sh_dist[:shadows], w.free)
             ci.add_visible(shadows, w, radiance)
-    return calls, len(pixel)
+    return wavefronts, len(pixel)
 
 
 @njit(nogil=True)
@@ -269,15 +272,17 @@ class EmbreeFloor:
     """The tracing path pyoa ships (Embree packets called from numba, the
     scene built as the renderer builds it) alone: the rays of a ``size``
     render of the same scene, sampler, spp and depth (:func:`record_rays`),
-    replayed on two threads (each half of the wavefronts) by :meth:`run`.
-    Each thread traces its wavefronts in one compiled call that releases the
-    GIL (:func:`replay_wavefronts`), as a render's worker traces a batch's:
-    no Python runs between two wavefronts. (Until commit fdffe45 the floor
-    called ``embree.intersect`` / ``occluded`` from Python once per
-    wavefront; the threads then queued for the GIL between calls, and that
-    floor was 1.17-1.31x lower on two threads than this one, measured in one
-    process on the Intel Xeon 6/207: docs/performance.md, "What the floor
-    is".)
+    replayed on two threads by :meth:`run`: each takes every other
+    wavefront, its closest hits and shadow rays, and traces them in one
+    compiled call that releases the GIL (:func:`replay_wavefronts`), as a
+    render's worker traces a batch's: no Python runs between two
+    wavefronts. Two earlier versions understated it (docs/performance.md,
+    "What the floor is"): until commit fdffe45 the threads called
+    ``embree.intersect`` / ``occluded`` from Python once per wavefront and
+    queued for the GIL between calls; until commit 8a2724a they took every
+    other *call*, and as the calls alternate closest hits and shadow rays,
+    one thread traced nearly all the closest hits and the other the shadow
+    rays.
     Its ``paths_per_s`` is the rate at the render's own rays per path: what
     the renderer would reach if shading, sampling and bookkeeping were free."""
 
@@ -285,15 +290,15 @@ class EmbreeFloor:
         from pyoa.render import embree
         from pyoa.render.compiled import integrator as ci
 
-        calls, paths = record_rays(scene, args, size)
+        wavefronts, paths = record_rays(scene, args, size)
         self.size, self.packet, self.mode = list(size), ci.packet_width(), tracing(scene)
         self.rtc = embree.Scene(scene.triangles, robust=scene.robust_tracing)
         self.fns = embree.query_addresses(self.packet)
-        self.rays = sum(len(c[1]) for c in calls)
+        self.rays = sum(len(c[1]) for wf in wavefronts for c in wf)
         self.rays_per_path = self.rays / paths
-        self.parts = [pack_calls(calls[0::2]), pack_calls(calls[1::2])]
+        self.parts = [pack_calls([c for wf in wavefronts[k::2] for c in wf]) for k in (0, 1)]
         self.times = []
-        self._trace(pack_calls(calls[:4]))  # compile and warm
+        self._trace(pack_calls(wavefronts[0] + wavefronts[1]))  # compile and warm
 
     def _trace(self, part):
         replay_wavefronts(self.rtc.handle, self.fns[0], self.fns[1], self.packet, *part)
