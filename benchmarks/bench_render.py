@@ -279,7 +279,7 @@ class EmbreeFloor:
     wavefronts. Two earlier versions understated it (docs/performance.md,
     "What the floor is"): until commit fdffe45 the threads called
     ``embree.intersect`` / ``occluded`` from Python once per wavefront and
-    queued for the GIL between calls; until commit 8a2724a they took every
+    queued for the GIL between calls; before commit 32ec017 they took every
     other *call*, and as the calls alternate closest hits and shadow rays,
     one thread traced nearly all the closest hits and the other the shadow
     rays.
