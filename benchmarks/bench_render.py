@@ -190,7 +190,6 @@ def record_rays(scene, args, size) -> tuple[list, int]:
     ``shading.shade``, ``add_visible``) one wavefront at a time from Python, as
     ``render_paths`` runs them in one compiled call, and copies each
     wavefront's rays before tracing them."""
-    from pyoa.render import embree
     from pyoa.render.camera import filter_offsets
     from pyoa.render.compiled import camera as ccam
     from pyoa.render.compiled import integrator as ci
@@ -257,8 +256,9 @@ def replay_wavefronts(scene, hit, occluded, width, kinds, offsets, o, d, dist):
 
 
 def pack_calls(calls: list) -> tuple:
-    """``(kinds, offsets, o, d, dist)``: the wavefronts ``calls`` of
-    :func:`record_rays` as contiguous arrays for :func:`replay_wavefronts`."""
+    """``(kinds, offsets, o, d, dist)``: the calls ``calls`` (of
+    :func:`record_rays`' wavefronts) as contiguous arrays for
+    :func:`replay_wavefronts`."""
     kinds = np.array([0 if kind == "hit" else 1 for kind, *_ in calls], np.int64)
     offsets = np.zeros(len(calls) + 1, np.int64)
     offsets[1:] = np.cumsum([len(o) for _, o, _, _ in calls])
@@ -287,7 +287,6 @@ class EmbreeFloor:
     the renderer would reach if shading, sampling and bookkeeping were free."""
 
     def __init__(self, scene, args, size=(96, 96)):
-        from pyoa.render import embree
         from pyoa.render.compiled import integrator as ci
 
         wavefronts, paths = record_rays(scene, args, size)
