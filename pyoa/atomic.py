@@ -96,6 +96,34 @@ def check_writable(path: str | os.PathLike) -> Path:
     return path
 
 
+def _file_id(path) -> tuple[int, int] | None:
+    """(device, inode) of the file at ``path``, symlinks followed; None if there is none."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):  # absent, a dangling symlink, an unreadable name
+        return None
+    return st.st_dev, st.st_ino
+
+
+def check_not_inputs(outputs, inputs) -> None:
+    """Refuse (ValueError, one line) an output that is one of a command's
+    inputs, before any work: writing it would replace what the command reads
+    (a render written over its own reference). ``outputs`` and ``inputs`` are
+    ``(option, path)`` pairs; a path that does not exist is none of them.
+    Files are compared by device and inode, so every spelling of one file is
+    caught: ``./ref.exr``, ``sub/../ref.exr``, a symlink to it, a hard link."""
+    seen = {}
+    for option, path in inputs:
+        fid = _file_id(path)
+        if fid is not None:
+            seen.setdefault(fid, (option, path))
+    for option, path in outputs:
+        hit = seen.get(_file_id(path)) if path is not None else None
+        if hit is not None:
+            raise ValueError(f"{option} {str(path)!r} is the same file as {hit[0]} {str(hit[1])!r} (one device and "
+                             f"inode), which this command reads: writing it would replace it; give another {option}")
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; on success it replaces ``path``.

@@ -9,6 +9,7 @@ which is sRGB-encoded display data.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from pathlib import Path
 
@@ -119,12 +120,19 @@ def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
     _write(path, to_srgb8(image), "uint8")
 
 
-def _open(path):
+def _open(path, what: str = "an image pyoa reads"):
+    """``path`` opened by OpenImageIO, after the regular-file check every
+    file pyoa reads gets (:func:`pyoa.render.state.check_state_file`): a
+    FIFO would block OpenImageIO's open for ever, a device be read for ever.
+    ``what`` says whose file it is in a refusal."""
+    from .state import check_state_file
+
     oiio = _oiio()
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such image: {str(path)!r}")
     if os.path.isdir(path):
         raise ValueError(f"{str(path)!r} is a directory, not an image")
+    check_state_file(path, what, "give an image file")
     inp = oiio.ImageInput.open(str(path))
     if inp is None:
         first = (oiio.geterror().strip().splitlines() or ["unknown format"])[0]
@@ -132,10 +140,10 @@ def _open(path):
     return inp
 
 
-def image_info(path: str | os.PathLike) -> tuple[int, int, int, str]:
+def image_info(path: str | os.PathLike, what: str = "an image pyoa reads") -> tuple[int, int, int, str]:
     """``(width, height, channels, pixel format)`` of an image file, from its
-    header only (nothing is decoded)."""
-    inp = _open(path)
+    header only (nothing is decoded); ``what`` names the file in a refusal."""
+    inp = _open(path, what)
     try:
         spec = inp.spec()
         return spec.width, spec.height, spec.nchannels, str(spec.format)
@@ -143,24 +151,41 @@ def image_info(path: str | os.PathLike) -> tuple[int, int, int, str]:
         inp.close()
 
 
-def read_image(path: str | os.PathLike) -> np.ndarray:
-    """Read an image (EXR, PNG, ...) as float32 ``(H, W, channels)``."""
-    inp = _open(path)
+def read_image(path: str | os.PathLike, what: str = "an image pyoa reads") -> np.ndarray:
+    """Read an image (EXR, PNG, ...) as float32 ``(H, W, channels)``; ``what``
+    names the file in a refusal. A file whose pixels cannot all be read (cut
+    short, damaged) is refused with OpenImageIO's reason."""
+    inp = _open(path, what)
     try:
         spec = inp.spec()
         pixels = inp.read_image("float")
+        # read_image's error is kept by the ImageInput (geterror), not globally
+        why = inp.geterror() if pixels is None else ""
     finally:
         inp.close()
     if pixels is None:
-        raise ValueError(f"reading {str(path)!r} failed")
+        first = (why.strip().splitlines() or ["no reason given"])[0]
+        raise ValueError(f"reading {str(path)!r} failed: it is truncated or damaged (OpenImageIO: {first})")
     return np.asarray(pixels, dtype=np.float32).reshape(spec.height, spec.width, -1)
+
+
+def pixel_digest(pixels: np.ndarray) -> str:
+    """SHA-256 (hex) of an image's shape and float32 pixels (little-endian):
+    what ties a reference's variance file to it (written by ``pyoa reference``,
+    checked by :func:`pyoa.render.reference.reference_noise`) and a study's
+    reference to its rows. Not of the file: the same pixels written again
+    (an EXR carries the time it was written) keep the digest."""
+    a = np.ascontiguousarray(pixels, dtype="<f4")
+    h = hashlib.sha256(repr(a.shape).encode())
+    h.update(a.tobytes())
+    return h.hexdigest()
 
 
 def check_reference(path, option: str, width: int, height: int) -> None:
     """Refuse (ValueError/FileNotFoundError) a reference image that is not
     linear radiance of ``width`` x ``height`` with RGB channels, from its
     header alone: checked before a render, not after it."""
-    w, h, c, fmt = image_info(path)
+    w, h, c, fmt = image_info(path, option)
     if fmt not in LINEAR_FORMATS:
         raise ValueError(f"{option} {str(path)!r} holds {fmt} pixels (display-encoded, e.g. an sRGB PNG), not linear "
                          "radiance; give a float or half image such as EXR or HDR (pyoa reference writes one)")
@@ -175,7 +200,7 @@ def read_reference(path, option: str, width: int, height: int) -> np.ndarray:
     """A reference image as float32 ``(height, width, 3)``: checked as
     :func:`check_reference`, and every pixel finite."""
     check_reference(path, option, width, height)
-    ref = read_image(path)[..., :3]
+    ref = read_image(path, option)[..., :3]
     check_finite(ref, f"{option} {str(path)!r}")
     return np.ascontiguousarray(ref)
 

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .image import check_finite, write_exr
+from .image import check_finite, pixel_digest, write_exr
 from .integrator import RENDERER_VERSION
 from .settings import RenderSettings
 from .state import (
@@ -71,6 +71,43 @@ def variance_path(out) -> Path:
     return out.with_name(out.name[: -len(out.suffix)] + ".variance.exr" if out.suffix else out.name + ".variance.exr")
 
 
+#: Header attribute (``pyoa:KEY``) of a variance file: the :func:`~.image.pixel_digest` of its reference.
+VARIANCE_OF = "reference_pixels_sha256"
+#: Header attributes a reference and its variance file share (:func:`render_reference` writes both):
+#: a variance file of before :data:`VARIANCE_OF` whose header differs from its reference's in one is another's.
+_SHARED = ("scene_sha256", "width", "height", "sampler", "spp", "seed", "passes", "pass_spp", "max_depth", "filter",
+           "shading", "renderer")
+
+
+def _check_variance_of(vp: Path, path, reference: np.ndarray) -> None:
+    """Refuse (ValueError) the variance file ``vp`` unless it is the variance
+    of the reference ``path`` whose pixels are ``reference``: its header's
+    :data:`VARIANCE_OF` must be their digest. A variance file of pyoa before
+    it (no digest) cannot be checked so: refused when the headers say it is
+    another image's (the reference's header names another kind, e.g. a
+    render written over it, or other settings), else used with a note on
+    stderr saying it is unchecked."""
+    from .provenance import read
+
+    var_meta = read(vp)
+    again = f"remove {vp} (its noise is then unknown) or make the reference again with pyoa reference"
+    digest = var_meta.get(VARIANCE_OF)
+    if digest is not None:
+        if digest != pixel_digest(reference):
+            raise ValueError(f"{vp} is the variance of another image than {str(path)!r} (its pixels changed since "
+                             f"the variance was written, e.g. an image written over it): {again}")
+        return
+    ref_meta = read(path)
+    kind = ref_meta.get("kind")
+    differ = [k for k in _SHARED if k in ref_meta and k in var_meta and ref_meta[k] != var_meta[k]]
+    if (kind is not None and kind != "reference") or differ:
+        said = f"their {differ[0]} differs" if differ else f"{str(path)!r} is a {kind}"
+        raise ValueError(f"{vp} is not the variance of {str(path)!r} ({said}): {again}")
+    print(f"pyoa: note: {vp} does not record which reference it belongs to (written before pyoa recorded it); "
+          f"taken as the variance of {str(path)!r} unchecked; make the reference again with pyoa reference to tie "
+          "them", file=sys.stderr)
+
+
 def reference_noise(path, reference: np.ndarray, crop) -> tuple[float, float] | None:
     """How much the reference ``path``'s own noise adds to a relative MSE
     measured against it, over the image and over ``crop``:
@@ -78,8 +115,9 @@ def reference_noise(path, reference: np.ndarray, crop) -> tuple[float, float] | 
     in its :func:`variance_path` file; None when it has none (a reference not
     made by ``pyoa reference``, whose noise is unknown). ``reference`` holds
     its pixels (H, W, 3). A variance path that is not a regular file is
-    refused (reading a FIFO hangs), not taken for none; one of another size
-    is refused as another reference's."""
+    refused (reading a FIFO hangs), not taken for none; one that is not this
+    reference's (:func:`_check_variance_of`: its header's digest of the
+    reference's pixels, and its size) is refused, never used."""
     from ..analysis.statistics import relmse_noise
     from .image import read_image
 
@@ -87,10 +125,11 @@ def reference_noise(path, reference: np.ndarray, crop) -> tuple[float, float] | 
     check_state_file(vp, "the variance of a reference", "remove or rename it")
     if not vp.exists():
         return None
-    var = read_image(vp)[..., :3].astype(np.float64)
+    var = read_image(vp, "the variance of a reference")[..., :3].astype(np.float64)
     if var.shape != reference.shape:
         raise ValueError(f"{vp} is {var.shape[1]} x {var.shape[0]}, its reference {reference.shape[1]} x "
                          f"{reference.shape[0]}: not this reference's variance; remove it")
+    _check_variance_of(vp, path, reference)
     return relmse_noise(var, reference), relmse_noise(var, reference, crop)
 
 
@@ -212,8 +251,7 @@ def render_reference(eng, scene, *, out, key: dict, settings: RenderSettings, se
     by the caller.
     ``metadata`` (:func:`pyoa.render.provenance.describe`) goes into both
     files' headers, with their kinds."""
-    from tqdm.auto import tqdm
-
+    from ..progress import bar as progress_bar
     from .scene_source import source_of
 
     state = state_path(out)
@@ -222,7 +260,7 @@ def render_reference(eng, scene, *, out, key: dict, settings: RenderSettings, se
     src = eng.share(scene if eng.client is None else source_of(scene))
     threads = eng.task_threads()
     results = eng.run(pass_task, [(src, settings, seed, k, threads) for k in todo], key="pyoa-pass")
-    with closing(results), tqdm(total=acc.passes, initial=acc.finished, desc=f"{Path(out).name} passes",
+    with closing(results), progress_bar(total=acc.passes, initial=acc.finished, desc=f"{Path(out).name} passes",
                                 unit="pass", disable=quiet) as bar:
         for _, (k, image) in results:
             acc.add(k, image)
@@ -231,8 +269,9 @@ def render_reference(eng, scene, *, out, key: dict, settings: RenderSettings, se
     meta = metadata or {}
     write_exr(out, mean, dict(meta, kind="reference") if meta else None)
     if var is not None:
+        # the digest of the pixels just written ties the variance to them (reference_noise checks it)
         write_exr(variance_path(out), var.astype(np.float32),
-                  dict(meta, kind="reference variance") if meta else None)
+                  {**(dict(meta, kind="reference variance") if meta else {}), VARIANCE_OF: pixel_digest(mean)})
     else:
         variance_path(out).unlink(missing_ok=True)  # not a stale one of another run
     state.unlink(missing_ok=True)

@@ -69,6 +69,7 @@ as ``pyoa.scenes``) load by name: ``load("cornell")``.
 from __future__ import annotations
 
 import gc
+import io
 import json
 import math
 import os
@@ -82,6 +83,7 @@ import numpy as np
 from pyoa.render.bsdf import Materials
 from pyoa.render.geometry import dot
 from pyoa.render.layout import MAX_DEPTH
+from pyoa.render.state import NotRegularFile, check_state_file, open_regular
 
 __all__ = ["Camera", "Scene", "SceneError", "UnknownSceneError", "load", "bundled", "rectangle", "cube"]
 
@@ -466,10 +468,15 @@ def _reject_constant(ctx: _Ctx):
 
 
 def _parse(path: Path, ctx: _Ctx) -> dict:
+    # read from the descriptor checked to be a regular file (a FIFO would block, a device be read for ever),
+    # with universal newlines as Path.read_text
     try:
-        text = path.read_text(encoding="utf-8")
+        with io.TextIOWrapper(open_regular(path, "a scene file", "give a scene .json file"), encoding="utf-8") as fh:
+            text = fh.read()
     except UnicodeDecodeError as e:
         raise ctx.error("", f"not UTF-8 text ({e})") from None
+    except NotRegularFile as e:
+        raise ctx.error("", str(e)) from None
     try:
         data = json.loads(text, object_pairs_hook=_no_duplicates(ctx), parse_constant=_reject_constant(ctx),
                           parse_int=_parse_int)
@@ -574,10 +581,18 @@ def _mesh(ctx: _Ctx, where: str, file, base: Path, memory: _MeshMemory) -> np.nd
 
     rel = _string(ctx, where, file)
     path = (base / rel).resolve()
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"{ctx.filename}: {where}: mesh file not found: {path}")
-    size = path.stat().st_size
-    memory.check(ctx, where, size * MESH_FILE_FACTOR, f"parsing mesh {rel!r} ({size} bytes)")
+    from .scene_source import _companions
+
+    try:  # a FIFO would block trimesh for ever, a device be read for ever: the mesh and the files it names
+        check_state_file(path, "a mesh file", "give a mesh file")
+        size = path.stat().st_size
+        memory.check(ctx, where, size * MESH_FILE_FACTOR, f"parsing mesh {rel!r} ({size} bytes)")
+        for companion in _companions(path):
+            check_state_file(companion, f"a file that mesh {rel!r} names", "give a regular file")
+    except NotRegularFile as exc:
+        raise ctx.error(where, str(exc)) from None
     try:
         mesh = trimesh.load(str(path), force="mesh", process=False)
     except MemoryError:
@@ -683,7 +698,7 @@ def _shapes(ctx: _Ctx, v, ids: dict[str, int], base: Path, camera: Camera, memor
 
 def _load_file(path: Path, max_bytes: int) -> Scene:
     ctx = _Ctx(path.name)
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"{path.name}: scene file not found: {path}")
     data = _parse(path, ctx)
     _check_keys(ctx, "", data, _TOP, required=("camera", "materials", "shapes"))

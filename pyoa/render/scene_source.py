@@ -100,11 +100,13 @@ def _gltf_json(path: Path, binary: bool) -> bytes:
 def _resolve(parent: Path, name: str) -> Path | None:
     """The file ``name`` names for trimesh's ``FilePathResolver`` rooted at
     ``parent``: the first of the name, the name without leading slashes
-    and its last component that is a file inside ``parent``; else None."""
+    and its last component that exists inside ``parent`` (trimesh opens it
+    whatever it is; :func:`pyoa.render.scene.load` refuses one that is not a
+    regular file); else None."""
     root = parent.resolve()
     for candidate in (name.strip(), name.strip().lstrip("/"), os.path.split(name)[-1]):
         path = (root / candidate).resolve()
-        if candidate and path.is_relative_to(root) and path.is_file():
+        if candidate and path.is_relative_to(root) and path.exists():  # trimesh opens what exists (a FIFO too)
             return path
     return None
 

@@ -95,7 +95,10 @@ def check_state_file(state, what: str, fix: str = NOT_REGULAR_FIX) -> None:
     (reading blocks), a directory. Such a path is neither read nor replaced. ``what`` says whose state it
     is, e.g. ``"where pyoa reference keeps its running sum"``; ``fix`` what
     the refusal suggests. Every file pyoa reads that a user could replace
-    is checked so (this, or :func:`open_regular`)."""
+    is checked so, this or :func:`open_regular` (the same rule, made on the
+    open file where pyoa reads it itself): states, images (what OpenImageIO
+    opens, :func:`pyoa.render.image.image_info`), variance files, scene and
+    mesh files (and the files a mesh names), a study's files."""
     try:
         mode = os.stat(state).st_mode
     except FileNotFoundError:  # absent, or a dangling symlink: the first write makes the file
