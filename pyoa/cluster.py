@@ -36,6 +36,7 @@ References
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 from collections.abc import Callable, Iterable, Iterator, Sequence
 
@@ -287,6 +288,10 @@ def _identity(address: str, timeout: float) -> dict:
         # connect() reaches us as such, a hung handshake as the timeout
         return asyncio.run(asyncio.wait_for(ask(), timeout + HANDSHAKE_GRACE))
 
+    refused = _refused(address, timeout)
+    if refused:
+        raise ClusterUnavailable(f"no Dask scheduler answered at {address!r}: {refused}; "
+                                 + _START_ONE.replace("ADDRESS", address))
     try:
         with ThreadPoolExecutor(1) as pool:
             info = pool.submit(run).result()
@@ -301,11 +306,39 @@ def _identity(address: str, timeout: float) -> dict:
     return info if isinstance(info, dict) else {}
 
 
+def _refused(address: str, timeout: float) -> str | None:
+    """Why nothing can answer at the TCP (``tcp``, ``tls``) ``address``, known at once: the connection
+    is refused (nothing listens on its port). None when something accepts it, or for another reason
+    (unreachable, unknown host, timed out, another scheme), which distributed's own attempt then says.
+
+    distributed retries a refused connection until its timeout (a scheduler may be starting), which
+    held a mistyped port for the whole :data:`CONNECT_TIMEOUT`; a scheduler that starts after pyoa
+    asked is not waited for."""
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    scheme, loc = parse_address(address)
+    if scheme not in ("tcp", "tls"):
+        return None
+    host, port = parse_host_port(loc)
+    try:
+        socket.create_connection((host, port), timeout=timeout).close()
+    except ConnectionRefusedError:
+        return f"connection refused: nothing listens on port {port} of {host}"
+    except OSError:
+        return None
+    return None
+
+
+#: How to get a scheduler, the end of every :class:`ClusterUnavailable` message.
+_START_ONE = ("start one with `dask scheduler` and workers with `dask worker ADDRESS`, or run in-process without "
+              f"--scheduler (and unset ${ENV_SCHEDULER})")
+
+
 def _unavailable(address: str, timeout: float, reason: str) -> ClusterUnavailable:
-    return ClusterUnavailable(
-        f"no Dask scheduler answered at {address!r} within {timeout:g} s ({reason}); start one with "
-        f"`dask scheduler` and workers with `dask worker {address}`, or run in-process without "
-        f"--scheduler (and unset ${ENV_SCHEDULER})")
+    return ClusterUnavailable(f"no Dask scheduler answered at {address!r} within {timeout:g} s ({reason}); "
+                              + _START_ONE.replace("ADDRESS", address))
 
 
 def _connect(address: str, timeout: float):
@@ -354,19 +387,70 @@ def engine(workers: int | None = None, scheduler: str | None = None, *,
     if workers is None and scheduler is None:
         eng = InProcess()
     elif workers is not None:
-        from distributed import Client, LocalCluster
+        from distributed import Client
 
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-        eng = DaskEngine(Client(cluster, set_as_default=False), f"a local cluster of {workers} worker processes",
-                         cluster)
+        cluster = _local_cluster(workers)
+        eng = DaskEngine(Client(cluster, set_as_default=False),
+                         f"a local cluster of {workers} worker process{'es' * (workers != 1)}", cluster)
     else:
         client = _connect(scheduler, CONNECT_TIMEOUT if timeout is None else timeout)
         eng = DaskEngine(client, f"the cluster at {scheduler}")
-        eng.description += f" ({len(eng._workers())} workers)"
+        n = len(eng._workers())
+        eng.description += f" ({n} worker{'s' * (n != 1)})"
     try:
         yield eng
-    finally:
-        eng.close()
+    except BaseException:
+        # an interruption or an error: what the cluster logs as it stops the tasks pyoa cancelled (a
+        # worker still busy is killed after a few seconds) is no news; pyoa's own line says what happened
+        from distributed.utils import silence_logging_cmgr
+
+        with silence_logging_cmgr(logging.CRITICAL + 1):
+            eng.close()
+        raise
+    eng.close()
+
+
+def _local_cluster(workers: int):
+    """A :class:`distributed.LocalCluster` of ``workers`` processes that Ctrl-C does not reach.
+
+    A terminal's Ctrl-C signals every process of the foreground job, the worker processes too: each
+    would print a traceback of its own. SIGINT is blocked in this thread while the cluster starts, so
+    that the thread running its event loop and the processes it spawns inherit the blocked signal
+    (the mask survives fork and exec); this process gets a Ctrl-C of that time once it is unblocked.
+    The workers import this module as their preload (:func:`dask_setup`)."""
+    import signal
+    import threading
+
+    from distributed import LocalCluster
+
+    hold = threading.current_thread() is threading.main_thread() and hasattr(signal, "pthread_sigmask")
+    if hold:
+        from multiprocessing import resource_tracker
+
+        # multiprocessing's resource tracker unblocks SIGINT in the thread that starts it, which would be the
+        # cluster's event loop as it spawns the first worker: started here, before the block, it is running then
+        resource_tracker.ensure_running()
+    cluster = None
+    try:
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hold else None
+        try:
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   preload=[__name__])
+        finally:
+            if hold:
+                signal.pthread_sigmask(signal.SIG_SETMASK, previous)  # a Ctrl-C held meanwhile is raised now
+    except BaseException:
+        if cluster is not None:
+            cluster.close()
+        raise
+    return cluster
+
+
+def dask_setup(worker) -> None:
+    """Run by distributed in each worker process of :func:`_local_cluster` as it starts (a preload):
+    a task that pyoa cancels (Ctrl-C, an error) is the client's decision, not news for the user, so
+    the workers' state machine, whose only warning is that one, logs errors only."""
+    logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
 
 
 def add_arguments(parser) -> None:
@@ -380,10 +464,10 @@ def add_arguments(parser) -> None:
 
 
 def progress_over(results: Iterable, total: int, desc: str, quiet: bool, unit: str = "task"):
-    """``results`` with a tqdm bar of ``total`` steps (none when ``quiet``)."""
-    from tqdm.auto import tqdm
+    """``results`` with a progress bar of ``total`` steps (:func:`pyoa.progress.bar`; none when ``quiet``)."""
+    from .progress import bar as progress_bar
 
-    with tqdm(total=total, desc=desc, unit=unit, disable=quiet) as bar:
+    with progress_bar(total=total, desc=desc, unit=unit, disable=quiet) as bar:
         for r in results:
             yield r
             bar.update(1)

@@ -24,10 +24,12 @@ both give the same bits).
 Build and cache
 ---------------
 :func:`build` compiles the algorithm with numba on first use in a process
-and builds the 16 sets: 4.6 s in all, of which 0.3 s is the build (later
-builds take 0.3 s); the pure-Python reference takes 0.017 s for the first
-``2**10`` points of one set and 1.5 s for a whole set (measured on a 2-core
-AMD EPYC VM, Python 3.11, numba 0.68). Loading the cached file and checking
+and builds the 16 sets: 5-12 s in all, of which 0.3-0.8 s is the build
+(later builds take that long), measured with Python 3.11 and numba 0.68 at
+4.6 s on a 2-core AMD EPYC VM, 9.1 s on an AMD EPYC Zen 5 and 11.6 s on 2
+shared cores of an Intel Xeon (family 6 model 207); the pure-Python reference
+takes 0.017 s for the first ``2**10`` points of one set and 1.5 s for a
+whole set (on the 2-core AMD EPYC VM). Loading the cached file and checking
 its SHA-256 takes about 10 ms. :func:`tables` builds the
 table once and keeps it in a file, ``pmj02-v1-16x65536.npy`` in the cache
 directory:
@@ -49,6 +51,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import sys
 import threading
 import warnings
 from collections.abc import Sequence
@@ -81,6 +84,9 @@ __all__ = ["BUILD_SEED", "CACHE_NAME", "POINTS", "POINTS_LOG2", "SETS", "SHAPE",
 SHAPE = (SETS, POINTS, 2)
 #: File name of the cached table (version 1 of the algorithm).
 CACHE_NAME = f"pmj02-v1-{SETS}x{POINTS}.npy"
+#: How long the first build takes, numba's compile included (the module docstring names the CPUs); the
+#: build announces itself with it on stderr, and every doc that times the build gives this range.
+BUILD_TIME = "5-12 s"
 #: SHA-256 of the table's little-endian bytes, as :func:`build` makes it.
 TABLE_SHA256 = "5c7049b680fae7663f3c77a2e03c3de50ebd77e3c6a4fd57a16d1087fd837cbd"
 
@@ -341,6 +347,9 @@ def tables() -> np.ndarray:
                 warnings.warn(f"the pmj02 table cache {str(path)!r} is invalid ({why}); rebuilding it",
                               RuntimeWarning, stacklevel=3)
         if table is None:
+            # a wait of several seconds (compile and build) that would otherwise be silent
+            print(f"building the pmj02 table (once: it is kept in {str(path)!r}; {BUILD_TIME}) ...", file=sys.stderr,
+                  flush=True)
             table = np.ascontiguousarray(build(), dtype=np.uint32)
             digest = table_sha256(table)
             if table.shape != SHAPE or digest != TABLE_SHA256:

@@ -512,9 +512,9 @@ class Sampler:
         chunks = [(r0, min(r0 + step, req.n_rows)) for r0 in range(0, req.n_rows, step)]
         bar = None
         if progress and len(chunks) > 1:
-            from tqdm.auto import tqdm
+            from .progress import bar as progress_bar
 
-            bar = tqdm(total=len(chunks), desc=f"pyoa {self.name}", unit="chunk")
+            bar = progress_bar(total=len(chunks), desc=f"pyoa {self.name}", unit="chunk")
 
         def fill(chunk):
             r0, r1 = chunk

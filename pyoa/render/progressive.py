@@ -158,15 +158,52 @@ class ProgressiveResult:
     stats: Stats = field(default_factory=Stats)
 
 
-def _bar(name: str, smp, done: int, quiet: bool):
-    """The progress bar of a progressive render (None when quiet): one bar for the whole render, in
-    samples per pixel, so that it moves inside a block too (the last block holds half the samples)."""
-    if quiet:
-        return None
-    from tqdm.auto import tqdm
+class _Bar:
+    """The progress bar of a progressive render (:func:`pyoa.progress.bar`): one bar for the whole render,
+    in whole samples per pixel. A batch of pixels adds a fraction of a sample, so the bar moves inside a
+    block too (the last block holds half the samples), and shows the samples every pixel has. With a
+    time budget, its time left is the budget's when that ends first (the render stops at the last
+    doubling predicted to fit in it), not the time to ``spp``."""
 
-    return tqdm(total=smp.spp, initial=done, unit="spp", desc=f"{name} {smp.name}",
-                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total} spp [{elapsed}<{remaining}{postfix}]")
+    def __init__(self, name: str, smp, done: int, time_budget: float | None, t_start: float):
+        from ..progress import bar
+
+        self.exact, self.start, self.budget, self.t_start = float(done), done, time_budget, t_start
+        self.bar = bar(total=smp.spp, initial=done, unit="spp", desc=f"{name} {smp.name}",
+                       bar_format=self._format(smp.spp))
+
+    def _format(self, total: int) -> str:
+        head = "{desc}: {percentage:3.0f}%|{bar}| {n}/{total} spp "
+        if self.budget is None:
+            return head + "[{elapsed}<{remaining}]"
+        from tqdm.std import tqdm
+
+        elapsed = time.perf_counter() - self.t_start
+        left = max(0.0, self.budget - elapsed)
+        if self.exact > self.start:  # the time to spp at this run's rate, when that is sooner
+            left = min(left, (total - self.exact) * elapsed / (self.exact - self.start))
+        return head + f"[{{elapsed}}<{tqdm.format_interval(left)}, --time {self.budget:g} s]"
+
+    def update(self, n: float) -> None:
+        """Advance by ``n`` samples per pixel (a fraction: a batch of the image's pixels)."""
+        self.exact += n
+        whole = min(int(self.exact + 1e-9), self.bar.total)
+        if whole > self.bar.n:
+            self.bar.bar_format = self._format(self.bar.total)
+            self.bar.update(whole - self.bar.n)
+
+    def reached(self, done: int) -> None:
+        """Every pixel has ``done`` samples (a block is complete)."""
+        self.exact = float(done)
+        self.bar.bar_format = self._format(self.bar.total)
+        self.bar.n = done  # whole again: the batches' fractions add up to the block but for rounding
+        self.bar.refresh()
+
+    def write(self, line: str) -> None:
+        self.bar.write(line)
+
+    def close(self) -> None:
+        self.bar.close()
 
 
 #: The settings of a progressive render that are not given: ``faure`` to 1,024 samples per pixel.
@@ -262,13 +299,11 @@ def render_progressive(scene, settings: RenderSettings | None = None, /, *, out,
     integrator = None
     block = np.empty_like(total)
     last_rate = None  # seconds per sample of the previous block
-    bar = _bar(scene.name, smp, done, quiet)
+    bar = None if quiet else _Bar(scene.name, smp, done, time_budget, t_start)
     try:
         for end in block_ends(done, smp.spp):
             n = end - done
             elapsed = time.perf_counter() - t_start
-            if bar is not None and time_budget is not None:
-                bar.set_postfix_str(f"--time {time_budget:g} s: {max(0.0, time_budget - elapsed):.0f} s left")
             if time_budget is not None and last_rate is not None and elapsed + last_rate * n > time_budget:
                 result.stopped_by_time = True
                 if bar is not None:
@@ -293,8 +328,7 @@ def render_progressive(scene, settings: RenderSettings | None = None, /, *, out,
             result.written.append(done)
             result.image, result.samples = image, done
             if bar is not None:
-                bar.n = done  # whole again: the batches' fractions add up to the block but for rounding
-                bar.refresh()
+                bar.reached(done)
                 bar.write(f"{done} of {smp.spp} samples per pixel -> {out} ({time.perf_counter() - t_start:.1f} s)")
     finally:
         if bar is not None:

@@ -16,7 +16,11 @@ keeps any named attribute, as pbrt-v4 keeps its render metadata there too):
 ``pyoa:sampler``          its catalogue name; ``pyoa:spp``, ``pyoa:seed``,
                           ``pyoa:base`` (faure), ``pyoa:samples`` (a
                           progressive render: samples so far)
-``pyoa:passes``           a reference: passes and ``pyoa:pass_spp``
+``pyoa:passes``           a reference: passes and ``pyoa:pass_spp``; its
+                          variance: ``pyoa:reference_pixels_sha256``, the
+                          digest of the reference's pixels
+                          (:func:`pyoa.render.image.pixel_digest`) that ties
+                          it to them
 ``pyoa:max_depth``        path length, ``pyoa:filter``, ``pyoa:shading``,
                           ``pyoa:layout`` (the sampler dimension of each
                           integrand dimension, as ``pyoa render`` prints it)
@@ -33,8 +37,10 @@ keeps any named attribute, as pbrt-v4 keeps its render metadata there too):
 from __future__ import annotations
 
 import functools
+import math
 import shlex
 import subprocess
+import unicodedata
 from pathlib import Path
 
 #: Prefix of pyoa's attributes in an image header.
@@ -97,6 +103,29 @@ def attributes(meta: dict | None) -> list[tuple[str, str | int]]:
             raise TypeError(f"image metadata {key!r} must be a str or an int, got {type(value).__name__}")
         out.append((PREFIX + key, value))
     return out
+
+
+def printable(value) -> str:
+    """``value`` as text safe to print on a terminal: control and format characters (newline, CR, ESC,
+    bidirectional overrides, ...) written as their Python escapes (``\\n``, ``\\r``, ``\\x1b``,
+    ``\\u202e``), so that a header string cannot forge a line of ``pyoa info`` or move the cursor.
+
+    >>> printable("cornell\\nkind  render\\x1b[2J")
+    'cornell\\\\nkind  render\\\\x1b[2J'
+    """
+    return "".join(ch.encode("unicode_escape").decode("ascii") if unicodedata.category(ch)[0] in "CZ" and ch != " "
+                    else ch for ch in str(value))
+
+
+def json_value(value):
+    """``value`` (a header attribute) as strict JSON takes it: a float that is not finite (a foreign
+    image's ``pyoa:spp = NaN``) as its string, ``"nan"``, ``"inf"`` or ``"-inf"``, since JSON has no
+    such numbers (in an array attribute too); other values as they are."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, (tuple, list)):
+        return [json_value(v) for v in value]
+    return value
 
 
 def read(path) -> dict:
