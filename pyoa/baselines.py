@@ -122,10 +122,9 @@ class Baseline(Construction):
 
     def nearest(self, spp, dims=None, strength=None):
         self._check(dims, strength)
-        if self.counts == "any":
-            near = min(max(int(spp), 1), MAX_SPP)
-            cands = [near, near + 1] if near < MAX_SPP else [near - 1, near]
-            return [self._choice(n, dims) for n in cands]
+        if self.counts == "any":  # every count in [1, max_spp]: the neighbours, not 16.7 million choices
+            near = min(max(int(spp), 0), self.max_spp + 1)
+            return [self._choice(n, dims) for n in (near - 1, near, near + 1) if 1 <= n <= self.max_spp]
         return nearest(self.choices(dims), spp)
 
     def solve(self, spp, dims, strength):

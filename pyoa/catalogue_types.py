@@ -174,11 +174,16 @@ class _Counts(Sequence):
         return isinstance(other, Sequence) and len(other) == self._len and all(a == b for a, b in zip(self, other))
 
 
-def nearest(choices: list[SppChoice], spp: int, k: int = 2) -> list[SppChoice]:
-    """The ``k`` choices closest to ``spp`` (ties broken towards fewer samples),
-    returned in increasing order of sample count."""
-    best = sorted(choices, key=lambda c: (abs(c.spp - spp), c.spp))[:k]
-    return sorted(best, key=lambda c: c.spp)
+def nearest(choices: list[SppChoice], spp: int) -> list[SppChoice]:
+    """The choices nearest ``spp`` on both sides: those of the largest count
+    below it, of ``spp`` itself, and of the smallest count above it (one side
+    is empty past the ends), in increasing order of sample count.
+
+    Both sides, not the two closest: the two closest can lie on one side
+    (``bose-bush`` near 256 would say 32 and 128, hiding 512)."""
+    below = max((c.spp for c in choices if c.spp < spp), default=None)
+    above = min((c.spp for c in choices if c.spp > spp), default=None)
+    return sorted((c for c in choices if c.spp in (below, spp, above)), key=lambda c: c.spp)
 
 
 def _labels(choices: list[SppChoice]) -> str:
@@ -367,7 +372,7 @@ class Construction:
         return prm
 
     def nearest(self, spp: int, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
-        """The two valid counts closest to ``spp``."""
+        """The valid counts nearest ``spp`` on both sides, and ``spp`` itself if valid (:func:`nearest`)."""
         return nearest(self.choices(dims=dims, strength=strength), spp)
 
 

@@ -27,7 +27,9 @@ sampler : str
     The pyoa sampler (default ``"bose"``): ``bose``, ``bush``, ``cmjnd``,
     ``addelman-kempthorne``, ``bose-bush``, ``faure`` or ``random``
     (:data:`pyoa._drjit.SUPPORTED`; the other comparison samplers read
-    tables and are left to Mitsuba's own samplers).
+    tables and are left to Mitsuba's own samplers), in any case, or a
+    Mitsuba/pbrt name of one of them (``orthogonal``, ``independent``:
+    :data:`pyoa.catalogue.ALIASES`), as everywhere a sampler is named.
 sample_count : int
     Samples per pixel, N (default 4). It must be a valid count of the
     sampler (``pyoa spp SAMPLER``); an invalid one fails when the scene loads

@@ -632,14 +632,15 @@ def _spp_rows(out: str) -> list[list[str]]:
 def test_cli_spp_lists_the_base_of_each_count(capsys):
     code, out, _ = run_cli(["spp", "faure", "--near", "100"], capsys)
     assert code == 0 and _spp_rows(out) == [["spp", "base", "full", "nets", "dims/block"],
-                                            ["100", "7", "7^2", "7"], ["101", "7", "7^2", "7"]]
-    assert [c.label() for c in pyoa.valid_spp("faure", near=100)] == ["100 (b=7)", "101 (b=7)"]
+                                            ["99", "7", "7^2", "7"], ["100", "7", "7^2", "7"],
+                                            ["101", "7", "7^2", "7"]]
+    assert [c.label() for c in pyoa.valid_spp("faure", near=100)] == ["99 (b=7)", "100 (b=7)", "101 (b=7)"]
     code, out, _ = run_cli(["spp", "faure", "--near", "100", "--dims", "5"], capsys)
-    assert code == 0 and _spp_rows(out)[1] == ["100", "5", "5^2", "5"]
+    assert code == 0 and _spp_rows(out)[2] == ["100", "5", "5^2", "5"]
     code, out, _ = run_cli(["spp", "faure", "--near", "100", "--base", "3"], capsys)
-    assert code == 0 and _spp_rows(out)[1:] == [["100", "3", "3^4", "3"], ["101", "3", "3^4", "3"]]
+    assert code == 0 and _spp_rows(out)[1:] == [["99", "3", "3^4", "3"], ["100", "3", "3^4", "3"], ["101", "3", "3^4", "3"]]
     code, out, _ = run_cli(["spp", "faure", "--near", "100", "--base", "4093"], capsys)
-    assert code == 0 and _spp_rows(out)[1] == ["100", "4093", "4093^0", "4093"]
+    assert code == 0 and _spp_rows(out)[2] == ["100", "4093", "4093^0", "4093"]
     code, out, _ = run_cli(["spp", "faure", "--base", "5", "--limit", "6"], capsys)
     rows = _spp_rows(out)
     assert [r[2] for r in rows[1:7]] == ["5^0"] * 4 + ["5^1"] * 2

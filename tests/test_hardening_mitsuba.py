@@ -107,7 +107,7 @@ def fresh():
 # (sampler, refused spp, pyoa's message)
 REFUSED = [
     ("bose", 9, r"samples_per_pass \(4\) must divide sample_count \(9\)"),
-    ("bose", 32, r"bose: 32 is not s\^2 .*nearest: 16 \(s=4\), 25 \(s=5\)"),
+    ("bose", 32, r"bose: 32 is not s\^2 .*nearest: 25 \(s=5\), 49 \(s=7\)"),
     ("faure", 4, r"samples_per_pass \(5\) must divide sample_count \(4\)"),
     ("faure", 32, r"samples_per_pass \(5\) must divide sample_count \(32\)"),
 ]
@@ -130,3 +130,31 @@ def test_a_refused_spp_leaves_the_sampler_as_it_was(fresh, key, refused, match):
     if name == "faure":
         assert smp.pyoa_sampler.params.s == 5  # faure's base (the largest prime b with b^2 <= 25)
     assert (bits(mi.render(sc, seed=5)) == image).all()
+
+
+# (what the scene names, the pyoa sampler it is): pbrt/Mitsuba names and any case, as everywhere a
+# sampler is named (the plugin used to refuse them: "orthogonal has no Dr.Jit implementation")
+SPELLINGS = [("orthogonal", "bose"), ("independent", "random"), ("BOSE", "bose"), ("Faure", "faure")]
+
+
+@pytest.mark.parametrize("spelled,name", SPELLINGS, ids=[s for s, _ in SPELLINGS])
+def test_aliases_and_case_resolve_through_the_catalogue(spelled, name):
+    import pyoa
+
+    assert pm._drjit.implementation(spelled) is pm._drjit.implementation(name) and pm._drjit.supports(spelled)
+    smp = mi.load_dict({"type": "pyoa", "sampler": spelled, "sample_count": 25})
+    assert smp.pyoa_sampler.name == name and f"PyoaSampler[{name}," in repr(smp)
+    P, D, seed = 3, 6, 7
+    smp.set_samples_per_wavefront(25)
+    smp.seed(seed, P * 25)
+    got = np.stack([np.asarray(smp.next_1d()) for _ in range(D)], -1).reshape(P, 25, D)
+    want = pyoa.sampler(name, spp=25, dims=D, seed=seed, backend="numpy").generate(pixels=range(P))
+    assert (got.view(np.uint32) == want.view(np.uint32)).all()
+
+
+def test_an_alias_without_a_dr_jit_implementation_names_both():
+    """``ldsampler`` is pyoa's sobol02, which reads tables: refused naming the alias and what it is."""
+    with pytest.raises(Exception) as info:
+        mi.load_dict({"type": "pyoa", "sampler": "ldsampler", "sample_count": 16})
+    assert "ldsampler (sobol02) has no Dr.Jit implementation" in str(info.value), str(info.value)
+    assert not pm._drjit.supports("ldsampler") and not pm._drjit.supports("nonsense")

@@ -190,7 +190,8 @@ def test_valid_spp_bush_and_gf_bose():
                                                  for s, t in [(8, 8), (16, 6), (64, 4), (256, 3)]]
     assert [c.s for c in pyoa.valid_spp("bush", strength=5)] == [5, 7, 8, 9, 11, 13, 16, 17, 19, 23, 25, 27]
     assert pyoa.valid_spp("bush", strength=8) == [pyoa.SppChoice(2**24, 8, 8, 9)]
-    assert [c.label() for c in pyoa.valid_spp("bush", near=8, strength=3)] == ["27 (s=3, t=3)", "64 (s=4, t=3)"]
+    # the neighbours on both sides of a count (one side past the smallest)
+    assert [c.label() for c in pyoa.valid_spp("bush", near=8, strength=3)] == ["27 (s=3, t=3)"]
     assert [c.label() for c in pyoa.valid_spp("bush", near=100)] == ["81 (s=9)", "121 (s=11)"]
     bose = {c.s for c in pyoa.valid_spp("bose")}
     assert {4, 8, 9, 16, 25, 27, 32, 49, 64, 81, 121, 125, 128, 169, 243, 256} <= bose
@@ -236,8 +237,8 @@ def test_valid_spp_index2():
     assert bb == [pyoa.SppChoice(2 * s * s, s, 2, 2 * s + 1) for s in (2, 4, 8, 16, 32, 64, 128)]
     assert [c.spp for c in bb] == [8, 32, 128, 512, 2048, 8192, 32768]
     assert [c.label() for c in pyoa.valid_spp("bose-bush", near=100)] == ["32 (s=4)", "128 (s=8)"]
-    assert [c.label() for c in pyoa.valid_spp("addelman-kempthorne", near=100)] == ["50 (s=5)", "98 (s=7)"]
-    assert [c.spp for c in pyoa.valid_spp("addelman-kempthorne", near=162)] == [98, 162]  # |98-162| < |242-162|
+    assert [c.label() for c in pyoa.valid_spp("addelman-kempthorne", near=100)] == ["98 (s=7)", "162 (s=9)"]
+    assert [c.spp for c in pyoa.valid_spp("addelman-kempthorne", near=162)] == [98, 162, 242]  # both sides
     for name in ("addelman-kempthorne", "bose-bush"):
         assert pyoa.valid_spp(name, strength=2) == pyoa.valid_spp(name)
         with pytest.raises(ValueError, match="strength 2 only"):  # as pyoa.sampler refuses it
@@ -288,8 +289,8 @@ def test_valid_spp():
     assert [c.label() for c in pyoa.valid_spp("bose", near=128)] == ["121 (s=11)", "169 (s=13)"]
     # prime powers count: 81 = 9^2 is nearer to 120 than 169
     assert [c.label() for c in pyoa.valid_spp("bose", near=120)] == ["81 (s=9)", "121 (s=11)"]
-    # a valid count is its own nearest; the next is 81 (|121-81| = 40 < |169-121| = 48)
-    assert [c.spp for c in pyoa.valid_spp("bose", near=121)] == [81, 121]
+    # a valid count is listed with its neighbours on both sides
+    assert [c.spp for c in pyoa.valid_spp("bose", near=121)] == [81, 121, 169]
     cubes = pyoa.valid_spp("cmjnd", strength=3)
     assert [c.spp for c in cubes] == [s**3 for s in range(2, 257)]
     assert cubes[1].label() == "27 (s=3, t=3)"
@@ -458,20 +459,20 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="bose", spp=289**2), ValueError, ["83521", "256", "80089 (s=283)", "85849 (s=293)",
                                                  "valid for", "bush (s=17, t=4)",
                                                  "cmjnd (s=17, t=4)"]),
-    (dict(name="bose", spp=512**2), ValueError, ["262144", "253009 (s=503)", "259081 (s=509)", "bush (s=64, t=3)"]),
-    (dict(name="bose", spp=4096**2), ValueError, ["16736281 (s=4091)", "16752649 (s=4093)", "bush (s=64, t=4)"]),
+    (dict(name="bose", spp=512**2), ValueError, ["262144", "259081 (s=509)", "271441 (s=521)", "bush (s=64, t=3)"]),
+    (dict(name="bose", spp=4096**2), ValueError, ["nearest: 16752649 (s=4093);", "bush (s=64, t=4)"]),
     # Bush: s a prime power, t <= s
-    (dict(name="bush", spp=8, strength=3), ValueError, ["8", "s^3", "s >= t", "27 (s=3, t=3)", "64 (s=4, t=3)",
+    (dict(name="bush", spp=8, strength=3), ValueError, ["8", "s^3", "s >= t", "nearest: 27 (s=3, t=3);",
                                                         "valid for", "cmjnd (s=2, t=3)"]),
-    (dict(name="bush", spp=16, strength=4), ValueError, ["16", "s^4", "256 (s=4, t=4)", "625 (s=5, t=4)",
+    (dict(name="bush", spp=16, strength=4), ValueError, ["16", "s^4", "nearest: 256 (s=4, t=4);",
                                                          "valid for", "bose (s=4)", "cmjnd (s=2, t=4)"]),
-    (dict(name="bush", spp=36), ValueError, ["36", "prime power", "25 (s=5)", "27 (s=3, t=3)", "cmjnd (s=6)"]),
+    (dict(name="bush", spp=36), ValueError, ["36", "prime power", "27 (s=3, t=3), 49 (s=7)", "cmjnd (s=6)"]),
     (dict(name="bush", spp=216, strength=3), ValueError, ["216", "125 (s=5, t=3)", "343 (s=7, t=3)",
                                                           "cmjnd (s=6, t=3)"]),
     (dict(name="bush", spp=289**2, strength=2), ValueError, ["83521", "s^2", "80089 (s=283)", "85849 (s=293)"]),
     (dict(name="bush", spp=1000, dims=3), ValueError, ["1000", "2 <= t <= 3", "961 (s=31)", "1024 (s=32)",
                                                        "cmjnd (s=10, t=3)"]),
-    (dict(name="bush", spp=1), ValueError, ["4 (s=2)", "9 (s=3)"]),
+    (dict(name="bush", spp=1), ValueError, ["nearest: 4 (s=2)"]),
     (dict(name="bush", spp=64, strength=1), ValueError, ["strength", "2"]),
     (dict(name="bush", spp=64, strength=25), ValueError, ["strength", "25"]),
     (dict(name="bush", spp=64, strength=0), ValueError, ["strength"]),
@@ -487,13 +488,13 @@ def test_thread_safety_mixed_requests(backend):
     # Addelman-Kempthorne: q odd, a prime (<= 2887) or an odd prime power <= 256
     (dict(name="addelman-kempthorne", spp=32), ValueError, ["32", "odd", "18 (s=3)", "50 (s=5)",
                                                             "32 is valid for bose-bush (s=4)"]),
-    (dict(name="addelman-kempthorne", spp=8), ValueError, ["8", "odd", "18 (s=3)", "50 (s=5)", "bose-bush (s=2)"]),
+    (dict(name="addelman-kempthorne", spp=8), ValueError, ["8", "odd", "nearest: 18 (s=3);", "bose-bush (s=2)"]),
     (dict(name="addelman-kempthorne", spp=2 * 15**2), ValueError, ["450", "odd prime", "338 (s=13)", "578 (s=17)"]),
     (dict(name="addelman-kempthorne", spp=2 * 289**2), ValueError, ["167042", "prime power (<= 256)",
                                                                     "160178 (s=283)", "171698 (s=293)"]),
     (dict(name="addelman-kempthorne", spp=2 * 343**2), ValueError, ["235298", "227138 (s=337)", "240818 (s=347)"]),
     (dict(name="addelman-kempthorne", spp=2 * 2889**2), ValueError, ["16692642", "2887",
-                                                                     "16577282 (s=2879)", "16669538 (s=2887)"]),
+                                                                     "nearest: 16669538 (s=2887)"]),
     (dict(name="addelman-kempthorne", spp=2 * 2903**2), ValueError, ["spp", "16777216"]),
     (dict(name="addelman-kempthorne", spp=49), ValueError, ["49", "18 (s=3)", "50 (s=5)",
                                                             "valid for bose (s=7), bush (s=7), cmjnd (s=7)"]),
@@ -506,11 +507,11 @@ def test_thread_safety_mixed_requests(backend):
     (dict(name="bose-bush", spp=18), ValueError, ["18", "power of two", "8 (s=2)", "32 (s=4)",
                                                   "18 is valid for addelman-kempthorne (s=3)"]),
     (dict(name="bose-bush", spp=2 * 6**2), ValueError, ["72", "power of two", "32 (s=4)", "128 (s=8)"]),
-    (dict(name="bose-bush", spp=2 * 256**2), ValueError, ["131072", "128", "8192 (s=64)", "32768 (s=128)"]),
-    (dict(name="bose-bush", spp=2 * 2887**2), ValueError, ["8192 (s=64)", "32768 (s=128)",
+    (dict(name="bose-bush", spp=2 * 256**2), ValueError, ["131072", "128", "nearest: 32768 (s=128)"]),
+    (dict(name="bose-bush", spp=2 * 2887**2), ValueError, ["nearest: 32768 (s=128);",
                                                            "valid for addelman-kempthorne (s=2887)"]),
     (dict(name="bose-bush", spp=64), ValueError, ["64", "32 (s=4)", "bose (s=8)", "bush (s=4, t=3)"]),
-    (dict(name="bose-bush", spp=2), ValueError, ["2", "8 (s=2)", "32 (s=4)"]),
+    (dict(name="bose-bush", spp=2), ValueError, ["2", "nearest: 8 (s=2)"]),
     (dict(name="bose-bush", spp=33), ValueError, ["33", "32 (s=4)"]),
     (dict(name="bose-bush", spp=32, strength=3), ValueError, ["strength 2 only", "strength=3"]),
     (dict(name="bose-bush", spp=32, strength=4), ValueError, ["strength 2 only"]),

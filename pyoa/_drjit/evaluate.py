@@ -31,16 +31,27 @@ SUPPORTED = tuple(n for n in catalogue.names() if n in IMPLEMENTATIONS)
 
 
 def supports(name: str) -> bool:
-    return name in IMPLEMENTATIONS
+    """Whether sampler ``name`` (any spelling :func:`pyoa.catalogue.get` accepts) has a Dr.Jit implementation."""
+    try:
+        return catalogue.get(name).name in IMPLEMENTATIONS
+    except (TypeError, ValueError):
+        return False
 
 
 def implementation(name: str):
-    """The Dr.Jit function of entry ``name``; ValueError naming the supported ones otherwise."""
+    """The Dr.Jit function of sampler ``name``; ValueError naming the supported ones otherwise.
+
+    ``name`` is resolved through the catalogue first (case, and the pbrt/Mitsuba
+    names of :data:`pyoa.catalogue.ALIASES`: ``"orthogonal"`` is ``bose``), as
+    :func:`pyoa.sampler` and the CLI resolve it; an unknown name gets the
+    catalogue's own message.
+    """
+    entry = catalogue.get(name)
     try:
-        return IMPLEMENTATIONS[name]
+        return IMPLEMENTATIONS[entry.name]
     except KeyError:
-        catalogue.get(name)  # an unknown name gets the catalogue's own message
-        raise ValueError(f"{name} has no Dr.Jit implementation (pyoa.mitsuba); supported: "
+        shown = entry.name if entry.name == name else f"{name} ({entry.name})"
+        raise ValueError(f"{shown} has no Dr.Jit implementation (pyoa.mitsuba); supported: "
                          f"{', '.join(SUPPORTED)}") from None
 
 

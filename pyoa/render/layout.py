@@ -52,6 +52,12 @@ class Layout:
     def __init__(self, *, max_depth: int, mis: bool, lens: bool, time: bool, first=None):
         if not 1 <= max_depth <= MAX_DEPTH:  # checked before a loop over the vertices
             raise ValueError(f"max_depth must be in [1, {MAX_DEPTH}], got {max_depth}")
+        # a str is itself a sequence (of letters): first="light1" would be read as 'l', 'i', ...
+        if isinstance(first, str) or not isinstance(first, (list, tuple, type(None))) \
+                or not all(isinstance(n, str) for n in first or ()):
+            raise TypeError(f"first must be a sequence of integrand dimension names, such as ['light1'] or "
+                            f"('pixel.x', 'pixel.y'), got {type(first).__name__} {first!r}"
+                            + (f"; for one name, give [{first!r}]" if isinstance(first, str) else ""))
         names = ["pixel.x", "pixel.y"]
         if lens:
             names += ["lens.u", "lens.v"]

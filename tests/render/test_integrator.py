@@ -547,7 +547,7 @@ def test_dof7d_renders_with_seven_dims():
 def test_render_rejects_bad_arguments(cornell):
     with pytest.raises(ValueError, match=r"unknown integrand dimension 'light9'; valid: pixel\.x"):
         render(cornell, spp=4, width=4, height=4, first=["light9"])
-    with pytest.raises(ValueError, match=r"bose: 10 is not .*nearest: 4 \(s=2\), 9 \(s=3\)"):
+    with pytest.raises(ValueError, match=r"bose: 10 is not .*nearest: 9 \(s=3\), 16 \(s=4\)"):
         render(cornell, sampler="bose", spp=10, width=4, height=4)
     with pytest.raises(ValueError, match="filter"):
         render(cornell, spp=4, width=4, height=4, filter="tent")

@@ -112,7 +112,7 @@ def test_render_reference_subtracts_the_reference_noise(tmp_path, capsys):
 @pytest.mark.parametrize("argv, message", [
     (["render", "nosuchscene"], r"nosuchscene: no such scene file or bundled scene; bundled: .*cornell"),
     (["render", "cornell", "--sampler", "nosuchsampler", "--spp", "4"], r"nosuchsampler"),
-    (["render", "cornell", "--sampler", "bose", "--spp", "10"], r"bose: 10 is not .*nearest: 4 \(s=2\), 9"),
+    (["render", "cornell", "--sampler", "bose", "--spp", "10"], r"bose: 10 is not .*nearest: 9 \(s=3\), 16"),
     (["render", "cornell", "--sampler", "sobol", "--spp", "12"], r"12"),
     (["render", "cornell", "--first", "light9"], r"unknown integrand dimension 'light9'; valid: pixel\.x"),
     (["render", "cornell", "--max-depth", "0"], r"--max-depth must be in \[1, \d+\], got 0"),
