@@ -45,6 +45,19 @@ def names(family: str | None = None) -> list[str]:
     return [n for n, c in SAMPLERS.items() if family is None or c.family == family]
 
 
+#: The samplers of ``pyoa compare`` and ``pyoa study`` given no ``--samplers``: bose first (their ratios
+#: are to the first sampler) and every comparison sampler.
+DEFAULT_SAMPLERS: tuple[str, ...] = ("bose", *names("baseline"))
+
+
+def shown(name: str) -> str:
+    """How a table names the sampler typed as ``name``: the catalogue's name, with ``name`` beside it
+    when that is an alias (``bose (orthogonal)``; ``BOSE`` is just ``bose``). Files store the catalogue's
+    name alone."""
+    canonical = get(name).name
+    return canonical if name.lower() == canonical else f"{canonical} ({name})"
+
+
 def get(name: str) -> Construction:
     """Look up a construction by name (or a pbrt/Mitsuba name in :data:`ALIASES`), with an error that
     lists the valid ones."""
@@ -67,8 +80,8 @@ def valid_spp(name: str, near: int | None = None, dims: int | None = None, stren
     name : str
         Sampler name, see :func:`pyoa.samplers`.
     near : int, optional
-        If given, only the two counts closest to ``near`` (or ``near`` itself
-        and its closest neighbour if it is valid).
+        If given, only the counts nearest it on both sides: the largest below
+        ``near``, ``near`` itself if it is valid, and the smallest above.
     dims : int, optional
         Number of dimensions the sampler will be asked for; for ``cmjnd``
         without ``strength`` it bounds the strengths considered (2..dims).

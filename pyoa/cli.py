@@ -29,6 +29,7 @@ from .backends import BackendUnavailable, PyoaFallbackWarning
 from .catalogue import get
 from .catalogue_types import MAX_UINT32, SppChoice, check_int
 from .cluster import TasksLost
+from .plots import FIGURE_WIDTH
 from .samplers import ENV_MAX_BYTES, trial_options
 
 #: The samples per pixel of every command that is given no ``--spp`` (``pyoa reference`` aside).
@@ -45,8 +46,17 @@ conventions, the same in every command:
             give is refused with the nearest valid counts, except by compare and study, which take
             each sampler's nearest and show it in their tables.
   --dims    always a number of dimensions; spectrum's pair of dimensions is --pair I,J.
-  --size    W H of a render; compare takes the reference's size when --size is not given.
-Old spellings (points --sampler X, spectrum --dims I,J) still work in this release, with a note."""
+  --size    W H of an image (render, compare, reference, study); compare and study take their
+            reference's size when --size is not given, and refuse a --size that differs from it.
+            A figure's width in pixels (plot, spectrum) is --figure-width PX.
+  --reference  one image (render, compare); a study's, one per scene: --reference SCENE=FILE,
+            repeated (FILE alone when the study has one scene), before or after the scenes.
+  --backend, --device  taken by every command that generates samples (points, plot, spectrum,
+            render, compare, reference, study): the sampler backend and OpenCL device.
+  names     a table shows the catalogue's name of a sampler, with the name typed beside it when
+            that was an alias: bose (orthogonal); CSV files and study.json store the catalogue's.
+Old spellings (points --sampler X, spectrum --dims I,J, plot/spectrum --size PX) still work in this
+release, with a note."""
 
 
 def deprecated(command: str, old: str, new: str) -> None:
@@ -54,11 +64,36 @@ def deprecated(command: str, old: str, new: str) -> None:
     print(f"pyoa {command}: note: {old} is deprecated and goes in the next release; write {new}", file=sys.stderr)
 
 
-def resolve_spp(args, name: str, default: int = DEFAULT_SPP) -> int:
-    """``--spp`` as given, or without it the sampler's valid count nearest ``default`` (said on stderr when
-    it is not ``default``, unless ``-q``)."""
-    if args.spp is not None:
-        return args.spp
+def add_sampling_options(p) -> None:
+    """``--backend`` and ``--device`` on the parser of a command that generates samples (points, plot,
+    spectrum, render, compare, reference, study): one definition, so every command takes and describes
+    them alike. The values go to :func:`pyoa.sampler` (``backend=``, ``device=``), and every backend and
+    device give the same bits."""
+    p.add_argument("--backend", choices=("opencl", "numpy"), default=None,
+                   help="sampler backend (default: $PYOA_BACKEND, else OpenCL when it works, else NumPy)")
+    p.add_argument("--device", default=None, metavar="SELECTOR",
+                   help="OpenCL device: gpu, cpu, P:D or part of its name, as pyoa backends lists them "
+                        "(default: $PYOA_OPENCL_DEVICE, else the first that builds pyoa's kernels)")
+
+
+def figure_width(args) -> int:
+    """``--figure-width PX`` of plot and spectrum, or its old spelling ``--size PX`` (with a note)."""
+    if args.size_old is not None and args.figure_width is not None and args.size_old != args.figure_width:
+        raise ValueError(f"two figure widths given: --figure-width {args.figure_width} and --size "
+                         f"{args.size_old}; give one, as --figure-width PX")
+    if args.size_old is not None:
+        deprecated(args.command, f"--size {args.size_old}",
+                   f"--figure-width {args.size_old} (--size is W H of an image in every other command)")
+        return args.size_old
+    return FIGURE_WIDTH if args.figure_width is None else args.figure_width  # checked by pyoa.plots
+
+
+def resolve_spp(args, name: str, default: int = DEFAULT_SPP, option: str = "spp") -> int:
+    """``--spp`` (or the count option ``option``, e.g. ``"pass_spp"``) as given, or without it the sampler's
+    valid count nearest ``default`` (said on stderr when it is not ``default``, unless ``-q``)."""
+    given = getattr(args, option)
+    if given is not None:
+        return given
     from .catalogue import nearest_spp
 
     dims = getattr(args, "dims", None)  # a count where the command has one (spectrum's old --dims is a pair)
@@ -66,7 +101,7 @@ def resolve_spp(args, name: str, default: int = DEFAULT_SPP) -> int:
                       strength=getattr(args, "strength", None))
     if spp != default and not getattr(args, "quiet", False):
         print(f"pyoa {args.command}: {get(name).name} has no {default}-sample set; using its nearest valid count, "
-              f"{spp} (give --spp to choose)", file=sys.stderr)
+              f"{spp} (give --{option.replace('_', '-')} to choose)", file=sys.stderr)
     return spp
 from .units import format_rate
 
@@ -143,6 +178,11 @@ def _sampler_arg(args, default: str = "bose") -> str:
     return args.sampler or default
 
 
+def _seconds(t: float) -> str:
+    """A duration to three significant digits: ``"0.497 ms"``, ``"12.3 ms"``, ``"2.448 s"``."""
+    return f"{t * 1e3:.3g} ms" if t < 1 else f"{t:.3f} s"
+
+
 def cmd_points(args) -> int:
     args.sampler = _sampler_arg(args)
     args.spp = resolve_spp(args, args.sampler)
@@ -152,6 +192,11 @@ def cmd_points(args) -> int:
                "device": args.device, "resolution": tuple(args.resolution) if args.resolution else None,
                "base": args.base}
     smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, **trial_options(args.sampler, options))
+    # One value first: it pays the one-time costs (the backend's kernel build, a table such as pmj02's,
+    # built once per machine), so that the rate below is the generation's alone, as render's is.
+    t0 = time.perf_counter()
+    smp.generate(pixels=pixels[:1], samples=range(1), dims=range(1))
+    setup = time.perf_counter() - t0
     t0 = time.perf_counter()
     x = smp.generate(pixels=pixels, progress=not args.quiet)
     dt = time.perf_counter() - t0
@@ -159,7 +204,8 @@ def cmd_points(args) -> int:
     if not args.quiet:
         print(smp)
         print(f"{x.size:,} values ({x.shape[0]} pixels x {x.shape[1]} samples x {x.shape[2]} dims) "
-              f"in {dt:.3f} s ({format_rate(x.size / max(dt, 1e-9))} values/s) -> {args.out}")
+              f"in {_seconds(dt)} ({format_rate(x.size / max(dt, 1e-9))} values/s), after {_seconds(setup)} of "
+              f"one-time setup (kernels, tables) -> {args.out}")
     return 0
 
 
@@ -210,7 +256,7 @@ def cmd_spp(args) -> int:
 
 def _options(args) -> dict:
     """The sampler options given on the command line (offset and jitter only when set)."""
-    opts = {"backend": args.backend}
+    opts = {"backend": args.backend, "device": args.device}
     if args.offset is not None:
         opts["offset"] = args.offset
     if args.jitter is not None:
@@ -227,7 +273,7 @@ def cmd_plot(args) -> int:
 
     args.spp = resolve_spp(args, args.sampler)
     projections(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, pixel=args.pixel, out=args.out,
-                size=args.size, **_options(args))
+                size=figure_width(args), **_options(args))
     if not args.quiet:
         print(f"{args.sampler}, {args.spp} spp, {args.dims} dims -> {args.out}")
     return 0
@@ -238,16 +284,17 @@ def cmd_spectrum(args) -> int:
 
     if args.dims is not None and args.pair is not None:
         raise ValueError("give the pair of dimensions once, as --pair I,J (--dims is its old spelling)")
-    if args.dims is not None:
-        deprecated("spectrum", f"--dims {args.dims}", f"--pair {args.dims} (--dims is a count in every command)")
     pair = args.pair or args.dims or "0,1"
+    option = "--pair" if args.dims is None else "--dims (the old spelling of --pair)"
     try:
         i, j = (int(v) for v in pair.split(","))
     except ValueError:
-        raise ValueError(f"--pair must be two dimensions I,J such as 0,1; got {pair!r}") from None
+        raise ValueError(f"{option} must be two dimensions I,J such as 0,1; got {pair!r}") from None
+    if args.dims is not None:  # advised only once parsed, so that the advice is a valid --pair
+        deprecated("spectrum", f"--dims {args.dims}", f"--pair {i},{j} (--dims is a count in every command)")
     args.spp = resolve_spp(args, args.sampler)
     _, radii, mean = spectrum(args.sampler, spp=args.spp, dims=(i, j), trials=args.trials, seed=args.seed,
-                              freq=args.freq, out=args.out, size=args.size, **_options(args))
+                              freq=args.freq, out=args.out, size=figure_width(args), **_options(args))
     if not args.quiet:
         low = mean[radii <= max(2, len(radii) // 8)].mean()
         print(f"{args.sampler}, {args.spp} spp, dims {i},{j}, {args.trials} trials: "
@@ -277,8 +324,11 @@ def cmd_backends(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     ap = argparse.ArgumentParser(prog="pyoa", description="Orthogonal-array sampling for Monte Carlo rendering.",
                                  epilog=CONVENTION, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--version", action="version", version=f"pyoa {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
     spp_help = (f"samples per pixel (default {DEFAULT_SPP}, or the sampler's valid count nearest it)")
@@ -300,8 +350,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resolution", type=int, nargs=2, metavar=("W", "H"), default=None,
                    help="image size of a sampler that needs one (zsobol; pixels row-major, y*W + x); "
                         "default 65536 65536")
-    p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="default: automatic")
-    p.add_argument("--device", default=None, help="OpenCL device selector (gpu, cpu, P:D, name)")
+    add_sampling_options(p)
     p.add_argument("--out", default="points.npy", help="output file, .npy or .csv (default points.npy)")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     p.set_defaults(func=cmd_points)
@@ -310,10 +359,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_samplers)
 
     p = sub.add_parser("spp", help="list a sampler's valid sample counts")
-    p.add_argument("sampler")
-    p.add_argument("--near", type=int, default=None, help="only the counts nearest this one")
-    p.add_argument("--dims", type=int, default=None)
-    p.add_argument("--strength", type=int, default=None)
+    p.add_argument("sampler", help="sampler name (see `pyoa samplers`)")
+    p.add_argument("--near", type=int, default=None, help="only the valid counts nearest this one on both sides (and it, if valid)")
+    p.add_argument("--dims", type=int, default=None,
+                   help="only the counts that give this many dimensions (default: any)")
+    p.add_argument("--strength", type=int, default=None,
+                   help="only the counts of this strength t (bush, cmjnd; default: any)")
     p.add_argument("--base", type=int, default=None,
                    help="faure's prime digit base (default: each count's default base, given --dims)")
     p.add_argument("--limit", type=int, default=40, help="print at most this many (default 40)")
@@ -331,10 +382,12 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--jitter", type=float, default=None, help="jitter amount in [0, 1]")
         p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
         p.add_argument("--base", type=int, default=None, help="faure's prime digit base")
-        p.add_argument("--backend", choices=("opencl", "numpy"), default=None)
-        p.add_argument("--size", type=int, default=900, help="figure size in pixels (default 900)")
+        add_sampling_options(p)
+        p.add_argument("--figure-width", type=int, default=None, metavar="PX",
+                       help=f"figure width in pixels (default {FIGURE_WIDTH})")
+        p.add_argument("--size", type=int, dest="size_old", default=None, help=argparse.SUPPRESS)  # the old spelling
         p.add_argument("--out", default=out, help=f"PNG output (default {out})")
-        p.add_argument("-q", "--quiet", action="store_true")
+        p.add_argument("-q", "--quiet", action="store_true", help="print nothing")
 
     p = sub.add_parser("plot", help="plot every 2D projection of one pixel's point set (PNG)")
     figure_options(p, "projections.png")
@@ -368,21 +421,56 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
               file=sys.stderr if file is None else file)
 
 
-def _stdout_closed() -> bool:
-    """Whether standard output's reader has gone (a BrokenPipeError may also
-    come from elsewhere: a socket, a subprocess)."""
-    import select
+class _ReaderMayLeave:
+    """``sys.stdout`` or ``sys.stderr`` while a command runs. When the reader of the pipe has gone
+    (``pyoa compare ... | head -1``), the rest of what is written goes to /dev/null and the command
+    carries on, so that the work it finishes still reaches its files (a BrokenPipeError would end it
+    with nothing written); :func:`main` then ends with the status of a tool that SIGPIPE ends."""
 
-    try:
-        poll = select.poll()
-        poll.register(sys.stdout.fileno(), select.POLLOUT)
-        # a pipe (or socket) whose reader has closed polls as an error
-        return any(events & select.POLLERR for _fd, events in poll.poll(0))
-    except (AttributeError, OSError, ValueError):  # no poll (Windows), no file descriptor
-        return False
+    def __init__(self, stream):
+        self.stream = stream
+        #: whether the reader has gone
+        self.gone = False
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+    def _guarded(self, call, *args):
+        try:
+            return call(*args)
+        except BrokenPipeError:
+            # the stream's descriptor goes to /dev/null, so that what is still buffered, and Python's flush
+            # at exit, do not fail again (https://docs.python.org/3/library/signal.html#note-on-sigpipe)
+            self.gone = True
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, self.stream.fileno())
+            os.close(devnull)
+            return call(*args)
+
+    def write(self, text: str) -> int:
+        return self._guarded(self.stream.write, text)
+
+    def flush(self) -> None:
+        self._guarded(self.stream.flush)
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``pyoa ARGS``: run the command, with a one-line message and status 2 for what it refuses. A
+    closed standard output (``| head``) neither stops the command nor makes it say anything: it
+    finishes, writes its files and ends with 141 = 128 + SIGPIPE, as a shell reports a tool whose
+    reader left."""
+    out, err = _ReaderMayLeave(sys.stdout), _ReaderMayLeave(sys.stderr)
+    sys.stdout, sys.stderr = out, err
+    try:
+        status = _main(argv)
+    finally:
+        out.flush()  # what is still buffered meets a closed pipe here, not in Python's flush at exit
+        err.flush()
+        sys.stdout, sys.stderr = out.stream, err.stream
+    return 128 + 13 if out.gone and not status else status  # 13: SIGPIPE
+
+
+def _main(argv: list[str] | None) -> int:
     ap = build_parser()
     args = ap.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)  # what made an image goes into its header
@@ -390,14 +478,6 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning
             return args.func(args)
-    except BrokenPipeError as exc:
-        if not _stdout_closed():
-            ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
-        # the reader of our output is gone (`pyoa spp bose | head`): stop quietly, as a C tool that SIGPIPE
-        # ends, with its status 128 + SIGPIPE; stdout goes to /dev/null so that Python's flush at exit
-        # does not fail again (https://docs.python.org/3/library/signal.html#note-on-sigpipe)
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 128 + 13
     except (ValueError, TypeError, OSError, BackendUnavailable, TasksLost) as exc:  # ClusterUnavailable: ValueError
         # OSError: an output that cannot be written (pyoa.atomic names the
         # user's path), a missing input file; a one-line message, not a traceback

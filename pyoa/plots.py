@@ -31,6 +31,8 @@ from .samplers import trial_options
 MAX_PLOT_DIMS = 16
 #: Figure sizes accepted, in pixels.
 MIN_SIZE, MAX_SIZE = 64, 8192
+#: The width in pixels of a figure given no ``size`` (``pyoa plot/spectrum --figure-width``).
+FIGURE_WIDTH = 900
 
 
 def _check_figure(out, size) -> None:
@@ -66,7 +68,7 @@ def _strata(smp) -> int:
 
 
 def projections(name: str, *, spp: int, dims: int, seed: int = 0, pixel: int = 0, out: str,
-                size: int = 900, **options) -> np.ndarray:
+                size: int = FIGURE_WIDTH, **options) -> np.ndarray:
     """Draw every 2D projection ``(i, j), i < j`` of one pixel's point set.
 
     Panel ``(j, i)`` of a lower-triangular matrix shows dimension ``i``
@@ -149,7 +151,8 @@ def power_spectrum(x: np.ndarray, freq: int) -> np.ndarray:
 
 
 def spectrum(name: str, *, spp: int, dims: tuple[int, int] = (0, 1), trials: int = 64, seed: int = 0,
-             freq: int = 48, out: str, size: int = 900, **options) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+             freq: int = 48, out: str, size: int = FIGURE_WIDTH,
+             **options) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Expected power spectrum of one 2D projection, averaged over ``trials``
     independent randomizations (pixels ``0 .. trials-1``), and its radial mean.
 

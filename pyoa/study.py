@@ -9,7 +9,8 @@ results arrive, so an interrupted study resumes and renders only what is
 missing; ``DIR/study.json`` holds the settings every row depends on (scene
 contents, size, crop, path length, filter, shading, references) and a study
 of other settings is refused rather than mixed in. Rows and settings name a
-sampler by its catalogue name (``BOSE`` is stored as ``bose``); a reference
+sampler by its catalogue name (``BOSE`` is stored as ``bose``; the report
+shows an alias beside it, ``bose (orthogonal)``); a reference
 is identified by its pixels (:func:`pixel_identity`) and the settings that
 rendered it, never by its file's bytes. One run at a time holds the
 directory (:func:`lock_study`).
@@ -33,7 +34,7 @@ The report (``DIR/study.md``, :func:`report`):
 
 Figures: ``DIR/study.png`` (every scene) and ``DIR/study-SCENE.png``, error
 against spp on log-log axes with the intervals as bands, like the paper's
-convergence plots.
+convergence plots (a band that reaches 0 is cut at the axis and marked).
 
 References
 ----------
@@ -62,13 +63,10 @@ import numpy as np
 
 from . import catalogue
 from .analysis.statistics import corrected, fit_loglog, mean_ci, ratio_ci
-from .atomic import atomic_path, check_writable
+from .atomic import atomic_path, check_not_inputs, check_writable
 from .catalogue_types import MAX_SPP, check_int
 from .units import format_interval, format_ratio
 
-#: Samplers of a study by default: the paper's table (random, the padded 2D
-#: samplers, bose, and the high-dimensional halton and sobol).
-DEFAULT_SAMPLERS = ("random", "jittered2d", "cmj2d", "sobol02", "bose", "halton", "sobol")
 #: Samplers that stratify pairs of dimensions and pad them (the paper's "(pad)";
 #: pbrt-v4's zsobol and pmj02 pad their pairs the same way, docs/samplers.md).
 PADDED = ("jittered2d", "cmj2d", "sobol02", "zsobol", "pmj02")
@@ -119,6 +117,52 @@ def sampler_names(text: str) -> list[str]:
     return list(dict.fromkeys(canonical_sampler(n) for n in parse_list(text, "--samplers")))
 
 
+def sampler_labels(text: str) -> dict[str, str]:
+    """``--samplers``' catalogue names, each with the name the report's tables show for it: the name
+    typed, beside the catalogue's when it is an alias (:func:`pyoa.catalogue.shown`)."""
+    if str(text).strip().lower() == "all":
+        return {n: n for n in catalogue.names()}
+    labels: dict[str, str] = {}
+    for n in parse_list(text, "--samplers"):
+        labels.setdefault(canonical_sampler(n), catalogue.shown(n))
+    return labels
+
+
+def reference_files(given: list[str] | None, scenes: list[str]) -> list[str] | None:
+    """``--reference`` (repeatable) as one image per scene, in the scenes' order; None without it.
+
+    Each value is ``SCENE=FILE``, SCENE one of ``scenes`` as typed; a bare ``FILE`` only when the
+    study has one scene (a file name may hold ``=``: a value whose head is no scene is a file). A
+    scene given two images, a scene without one, and an image that names no scene of several are
+    refused, each with the form to use."""
+    if not given:
+        return None
+    files: dict[str, str] = {}
+    for value in given:
+        heads = [s for s in scenes if value.startswith(s + "=")]
+        if heads:
+            scene = max(heads, key=len)
+            file = value[len(scene) + 1:]
+            if not file:
+                raise ValueError(f"--reference {value!r} names no file; give --reference {scene}=FILE")
+        elif "=" in value and not os.path.lexists(value):
+            head = value.split("=", 1)[0]
+            raise ValueError(f"--reference {value!r}: {head!r} is not a scene of this study "
+                             f"({', '.join(scenes)}); give --reference SCENE=FILE")
+        elif len(scenes) == 1:
+            scene, file = scenes[0], value
+        else:
+            raise ValueError(f"--reference {value!r} does not say its scene, and this study has {len(scenes)}; "
+                             f"give one --reference SCENE=FILE per scene, e.g. --reference {scenes[0]}={value}")
+        if files.setdefault(scene, file) != file:
+            raise ValueError(f"two references for {scene}: {files[scene]!r} and {file!r}; give one")
+    missing = [s for s in scenes if s not in files]
+    if missing:
+        raise ValueError(f"no --reference for {', '.join(missing)}; give one --reference SCENE=FILE per scene "
+                         f"(e.g. --reference {missing[0]}=REF.exr), or --reference-spp N to render them")
+    return [files[s] for s in scenes]
+
+
 @dataclass(frozen=True)
 class Job:
     """One render of the study."""
@@ -150,10 +194,9 @@ def pixel_identity(pixels: np.ndarray) -> str:
     """A reference's identity: the SHA-256 of its shape and its float32 RGB
     pixels (little-endian). Not of its file: writing the same pixels again
     (an EXR carries the time it was written) keeps the identity."""
-    a = np.ascontiguousarray(pixels, dtype="<f4")
-    h = hashlib.sha256(repr(a.shape).encode())
-    h.update(a.tobytes())
-    return PIXELS + h.hexdigest()
+    from .render.image import pixel_digest
+
+    return PIXELS + pixel_digest(pixels)
 
 
 def is_reference(saved: str | None, path: Path, pixels: np.ndarray) -> bool:
@@ -366,6 +409,8 @@ def load_settings(path: Path) -> dict | None:
         saved = json.loads(data)
     except ValueError as exc:
         raise ValueError(f"{path} is not a study's settings ({type(exc).__name__}); {afresh}") from None
+    except RecursionError:  # the parser recurses once per nested list or object
+        raise ValueError(f"{path} is not a study's settings (lists or objects nested too deeply); {afresh}") from None
     if isinstance(saved, dict) and _is_int(saved.get("version")) and saved["version"] != STUDY_VERSION:
         raise ValueError(f"{path} was written by another pyoa version; give another --out")
     try:
@@ -436,6 +481,28 @@ def _row(raw: dict) -> dict | None:
     return row
 
 
+def _records(path: Path, text: str, damaged: str) -> list[tuple[int, list[str], bool]]:
+    """The CSV records of ``text`` (study.csv's), each as ``(its first line,
+    its fields, whether it is complete)``: a record is complete when its line
+    break was written, so only the last can be incomplete (cut short, in a
+    quoted field too). A record csv cannot read is refused (ValueError
+    naming the file, the line and csv's reason, then ``damaged``)."""
+    f = io.StringIO(text, newline="")
+    reader = csv.reader(f, strict=True)  # strict: a quoted field cut at the end is an error, not a record
+    records = []
+    while True:
+        number = reader.line_num + 1
+        try:
+            fields = next(reader)
+        except StopIteration:
+            return records
+        except csv.Error as exc:
+            if f.tell() == len(text) and str(exc) == "unexpected end of data":  # cut inside a quoted field
+                return [*records, (number, [], False)]
+            raise ValueError(f"{path}: line {number}: {exc}; {damaged}") from None
+        records.append((number, fields, f.tell() < len(text) or text.endswith("\n")))
+
+
 def read_rows(path: Path, repair: bool = False) -> list[dict]:
     """The complete rows of ``study.csv``, once each. A line cut short by an
     interruption is dropped; so is a second row of the same (scene, sampler,
@@ -445,30 +512,36 @@ def read_rows(path: Path, repair: bool = False) -> list[dict]:
     spells them. With ``repair`` (the study's own run, holding the lock) the
     file is rewritten that way when it differs, saying so on stderr. A file
     that is not a study's CSV is refused, as is one that is not a regular
-    file (:func:`pyoa.render.state.open_regular`)."""
+    file (:func:`pyoa.render.state.open_regular`) and a damaged one (not
+    UTF-8, a field over the csv module's limit).
+
+    The file is read as CSV, not line by line: a scene's name may hold a
+    newline, a quote or a comma, which :class:`RowWriter` quotes."""
     from .render.state import open_regular
 
     if not path.exists():
         return []
-    # read from the descriptor that was checked (universal newlines, as Path.read_text)
-    with io.TextIOWrapper(open_regular(path, "the study's rows")) as fh:
-        text = fh.read()
-    lines = text.splitlines(keepends=True)
-    if not lines:
+    damaged = "the file is damaged: move it away (its rows are then rendered again), or give another --out"
+    # read from the descriptor that was checked; newline="": quoted fields keep their line breaks (csv's rule)
+    try:
+        with io.TextIOWrapper(open_regular(path, "the study's rows"), encoding="utf-8", newline="") as fh:
+            text = fh.read()
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path} is not UTF-8 text ({exc.reason} at byte {exc.start}); {damaged}") from None
+    records = _records(path, text, damaged)
+    if not records:
         return []
-    if lines[0].strip() != ",".join(FIELDS):
+    if records[0][1] != list(FIELDS):
         raise ValueError(f"{path} is not a pyoa study's CSV (its header is not {','.join(FIELDS)}); give another "
                          "--out")
-    rows, first, dropped, renamed, cut = [], {}, 0, 0, 0
-    for number, line in enumerate(lines[1:], 2):
-        if not line.endswith("\n"):
-            cut += 1  # the last row, cut short when the study was killed
-            continue
-        raw = next(csv.DictReader(io.StringIO(lines[0] + line)), None)
+    rows, first, dropped, renamed = [], {}, 0, 0
+    cut = len(records) > 1 and not records[-1][2]  # the last row, cut short when the study was killed
+    for number, fields, _ in records[1:len(records) - cut]:
+        raw = dict(zip(FIELDS, fields)) if len(fields) == len(FIELDS) else None
         row = _row(raw) if raw else None
         if row is None:
-            raise ValueError(f"{path}: a row that is not a study's: {line.strip()!r}; remove the file, or give "
-                             "another --out")
+            raise ValueError(f"{path}: line {number}: a row that is not a study's: {','.join(fields)[:200]!r}; "
+                             "remove the file, or give another --out")
         renamed += row["sampler"] != raw["sampler"]
         seen = first.get(ident(row))
         if seen is not None:
@@ -487,7 +560,7 @@ def read_rows(path: Path, repair: bool = False) -> list[dict]:
         writer.writeheader()
         writer.writerows({k: r[k] for k in FIELDS} for r in rows)
         with atomic_path(path) as tmp:
-            tmp.write_text(buf.getvalue())
+            tmp.write_text(buf.getvalue(), encoding="utf-8")
         said = []  # a cut line goes without a word, as it always has
         if dropped:
             said.append(f"dropped {dropped} duplicate row{'s' * (dropped != 1)} (a scene, sampler, spp and seed "
@@ -500,11 +573,12 @@ def read_rows(path: Path, repair: bool = False) -> list[dict]:
 
 
 class RowWriter:
-    """Appends rows to ``study.csv``, one flushed line each."""
+    """Appends rows to ``study.csv``, one flushed CSV record each (UTF-8; a scene name holding a line break
+    or a quote is quoted, as :func:`read_rows` reads it)."""
 
     def __init__(self, path: Path):
         new = not path.exists() or path.stat().st_size == 0
-        self.fh = open(path, "a", newline="")  # noqa: SIM115 - open for the whole study
+        self.fh = open(path, "a", newline="", encoding="utf-8")  # noqa: SIM115 - open for the whole study
         self.writer = csv.DictWriter(self.fh, fieldnames=FIELDS, lineterminator="\n")
         if new:
             self.writer.writeheader()
@@ -586,8 +660,10 @@ def _ratio(a: Cell, b: Cell) -> str:
     return format_ratio(*ratio_ci(a.values, b.values, shift_a=a.noise, shift_b=b.noise))
 
 
-def headline(table: dict) -> list[str]:
-    """Markdown: per scene and spp, bose / the best padded sampler and bose / sobol."""
+def headline(table: dict, labels: dict | None = None) -> list[str]:
+    """Markdown: per scene and spp, bose / the best padded sampler (of those in ``table``) and bose / sobol
+    (``labels``: the names shown, :func:`sampler_labels`)."""
+    labels = labels or {}
     lines = ["| scene | spp | best padded | bose / best padded | bose / sobol |", "|---|---:|---|---:|---:|"]
     any_row = False
     for scene, by_sampler in table.items():
@@ -596,16 +672,21 @@ def headline(table: dict) -> list[str]:
             padded = [(by_sampler[n][asked], n) for n in PADDED if asked in by_sampler.get(n, {})]
             best = min(padded, key=lambda cn: cn[0].ci()[0]) if padded else None
             sob = by_sampler.get("sobol", {}).get(asked)
-            lines.append(f"| {scene} | {c.spp} | {best[1] + ' ' + str(best[0].spp) if best else '-'} | "
+            shown = f"{labels.get(best[1], best[1])} {best[0].spp}" if best else "-"
+            lines.append(f"| {scene} | {c.spp} | {shown} | "
                          f"{_ratio(c, best[0]) if best else '-'} | {_ratio(c, sob) if sob else '-'} |")
             any_row = True
     return lines if any_row else []
 
 
 def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=None, seconds=None,
-           where: str = "") -> str:
+           where: str = "", labels: dict | None = None) -> str:
     """The Markdown report of a study (see the module docstring); ``seconds``
-    the time of every run so far (``settings["runs"]``)."""
+    the time of every run so far (``settings["runs"]``); ``labels`` the names its tables show
+    (:func:`sampler_labels`; default: the catalogue's)."""
+    from .render.reference import variance_path
+
+    labels = labels or {}
     table = cells(rows, noise)
     n_runs = len(settings.get("runs", []))
     runs = f" ({n_runs} runs: the first and its resumptions)" if n_runs > 1 else ""
@@ -622,13 +703,15 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
         s = settings["scenes"].get(scene, {})
         nz = noise.get(scene)
         ref = s.get("reference_name", "?")
+        passes = s.get("reference_passes")
+        # its header's count for a given image (header_passes); an image pyoa did not make has none
+        whence = f"of its {passes} passes" if passes else f"in {variance_path(ref).name}"
         if nz is None:
             say = ("its own noise is unknown (no variance file beside it; references made with `pyoa reference` "
                    "have one), so the figures are not corrected")
         else:
             say = (f"its own noise adds an estimated {nz[0]:.2g} to every image relMSE and {nz[1]:.2g} to every "
-                   f"crop relMSE (from the per-pixel variance of its {s.get('reference_passes', '?')} passes); "
-                   "both are subtracted below")
+                   f"crop relMSE (from the per-pixel variance {whence}); both are subtracted below")
         lines += [f"## {scene}", "", f"Reference `{ref}`: {say}.", ""]
         asked = sorted({a for by in by_sampler.values() for a in by})
         names = [n for n in (samplers or by_sampler) if n in by_sampler]
@@ -647,27 +730,34 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
                     note = f" ({c.spp})" if c.spp != a else ""
                     cols.append(format_interval(*c.ci(crop)) + note)
                 sl = slope(by, crop)
-                lines.append(f"| {n} | " + " | ".join(cols) + f" | {sl:.2f} |" if math.isfinite(sl) else
-                             f"| {n} | " + " | ".join(cols) + " | - |")
+                shown = labels.get(n, n)
+                lines.append(f"| {shown} | " + " | ".join(cols) + f" | {sl:.2f} |" if math.isfinite(sl) else
+                             f"| {shown} | " + " | ".join(cols) + " | - |")
             lines.append("")
         seeds = sorted({c.seeds for by in by_sampler.values() for c in by.values()})
         lines += [f"Seeds per cell: {', '.join(map(str, seeds))}. A count in parentheses is the sampler's nearest "
                   "valid one, used instead of the column's.", ""]
-    head = headline(table)
+    head = headline(table, labels)
+    # the padded samplers this report holds: the best is chosen among those that ran, and only they are named
+    padded = [n for n in PADDED if any(n in by for by in table.values())]
     if head:
         lines += ["## Headline", "",
                   "Ratios of noise-corrected mean image relMSE (below 1: bose is better), with 95 % intervals "
                   "over seeds (delta method on the log ratio with Student's t at Welch-Satterthwaite degrees of "
-                  "freedom, which holds its level with 2 to 8 seeds; see pyoa.analysis.ratio_ci); the best "
-                  "padded sampler is the one of " + ", ".join(PADDED) +
-                  " with the lowest mean at that count.", "", *head, ""]
+                  "freedom, which holds its level with 2 to 8 seeds; see pyoa.analysis.ratio_ci); " +
+                  (f"the best padded sampler is the one of {', '.join(labels.get(n, n) for n in padded)} with the "
+                   "lowest mean at that count." if padded else
+                   f"no padded 2D sampler ({', '.join(PADDED)}) was run, so that column is empty."),
+                  "", *head, ""]
     return "\n".join(lines)
 
 
 def figure(table: dict, scenes: list[str], samplers: list[str]):
     """The study's figure (Matplotlib's Agg canvas): error against spp on log-log axes, one panel per
     scene, one line per sampler with its 95 % band, the x axis labelled with the counts asked for;
-    None when no scene of ``scenes`` has rows."""
+    None when no scene of ``scenes`` has rows. A band whose lower end is at or below 0 (the
+    noise-corrected interval reaches 0) runs down to the panel's floor, a triangle there marks each
+    such count, and the legend says so."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import FixedFormatter, FixedLocator, NullLocator
@@ -686,6 +776,7 @@ def figure(table: dict, scenes: list[str], samplers: list[str]):
     colour = {n: colours[(2 * k) % 20 + (2 * k) // 20 % 2] for k, n in enumerate(samplers)}
     for i, scene in enumerate(scenes):
         ax = fig.add_subplot(rows_, cols, i + 1)
+        series = []
         for name in samplers:
             by = table[scene].get(name)
             if not by:
@@ -702,9 +793,26 @@ def figure(table: dict, scenes: list[str], samplers: list[str]):
             (line,) = ax.loglog(n[keep], m[keep], marker="o", ms=3, lw=1.2, color=colour[name],
                                 label=f"{name} ({sl:.2f})" if math.isfinite(sl) else name,
                                 ls="-" if name not in PADDED else "--")
-            band = keep & np.isfinite(lo) & (lo > 0)
+            series.append((line.get_color(), n, lo, hi, keep))
+        # A lower end at or below 0 has no place on a log axis, and dropping its band hid that the interval
+        # reaches 0: such a band runs down to the panel's floor (half a decade under its lowest positive
+        # value), where a triangle marks the count and the legend says why.
+        lows = [np.min(ln.get_ydata()) for ln in ax.get_lines()]  # the means drawn, all positive
+        lows += [v for _, n, lo, hi, keep in series for v in lo[keep & (lo > 0)]]
+        floor = min(lows, default=1.0) / 10 ** 0.5
+        cut_any = False
+        for c, n, lo, hi, keep in series:
+            band = keep & np.isfinite(lo) & np.isfinite(hi)
             if band.any():
-                ax.fill_between(n[band], lo[band], hi[band], color=line.get_color(), alpha=0.18, lw=0)
+                ax.fill_between(n[band], np.where(lo > 0, lo, floor)[band], hi[band], color=c, alpha=0.18, lw=0)
+            cut = band & ~(lo > 0)
+            if cut.any():
+                ax.plot(n[cut], np.full(cut.sum(), floor), ls="none", marker="v", ms=6, color=c, clip_on=False)
+                cut_any = True
+        if cut_any:
+            ax.set_ylim(bottom=floor)
+            ax.plot([], [], ls="none", marker="v", ms=6, color="0.4",
+                    label="95 % interval reaches 0:\nband cut at the axis")
         # the counts asked for, as plain numbers (a log axis alone labels 2 x 10^1 and leaves the rest
         # blank); a sampler's nearest valid count is plotted where it is, unlabelled
         counts = sorted({asked for by in table[scene].values() for asked in by})
@@ -752,6 +860,15 @@ def _made_with(saved: dict) -> str:
     if spp and passes:
         return f"a reference of {_in_passes(spp, passes)} (--reference-spp {spp} --pass-spp {spp // passes})"
     return f"the given reference {saved.get('reference_name', '?')}"
+
+
+def header_passes(path) -> int | None:
+    """The passes a reference's header records (``pyoa:passes``, :mod:`pyoa.render.provenance`), or
+    None for an image that records none (one pyoa did not make, or a count that is not an int >= 1)."""
+    from .render.provenance import read
+
+    passes = read(path).get("passes")
+    return passes if _is_int(passes, 1) else None
 
 
 def _by_file(saved: dict) -> bool:
@@ -863,7 +980,7 @@ def run(args) -> int:
     from .render.image import check_crop, read_reference
     from .render.integrator import RENDERER_VERSION
     from .render.provenance import command_line, describe
-    from .render.reference import reference_noise, render_reference
+    from .render.reference import reference_noise, render_reference, variance_path
     from .render.render import plan, resolve_shading
     from .render.scene import load
     from .render.scene_source import source_of
@@ -886,11 +1003,22 @@ def run(args) -> int:
     if args.reference and args.reference_spp is not None:
         raise ValueError("give --reference (existing images) or --reference-spp (render them), not both")
     if not args.reference and args.reference_spp is None:
-        raise ValueError("a study needs references: --reference REF.exr per scene, or --reference-spp N to "
-                         "render them (pyoa reference, e.g. 16384)")
-    if args.reference and len(args.reference) != len(scenes_arg):
-        raise ValueError(f"--reference gives {len(args.reference)} image(s) for {len(scenes_arg)} scene(s); give "
-                         "one per scene, in the scenes' order")
+        raise ValueError("a study needs references: --reference SCENE=REF.exr per scene (REF.exr alone for one "
+                         "scene), or --reference-spp N to render them (pyoa reference, e.g. 16384)")
+    args.reference = reference_files(args.reference, scenes_arg)  # one per scene, in the scenes' order
+    if args.reference:
+        # the references fix the size, as in pyoa compare; one of another size than --size (or than the
+        # first reference) is refused before the study's directory is made
+        from .render.image import check_reference, image_info
+        from .render.state import check_state_file
+
+        for path in args.reference:
+            # OpenImageIO would wait on a FIFO for ever, and read /dev/zero until memory runs out
+            check_state_file(path, "--reference", "give the reference image itself")
+        if args.size is None:
+            args.size = list(image_info(args.reference[0], "--reference")[:2])
+        for path in args.reference:
+            check_reference(path, "--reference", *args.size)
     pass_spp = None
     if args.reference_spp is not None:
         check_int("--reference-spp", args.reference_spp, 1)
@@ -907,7 +1035,7 @@ def run(args) -> int:
         size = dict(width=args.size[0], height=args.size[1]) if args.size else dict(width=None, height=None)
         # every render of the study, its references' passes included, with its sampler, count and seed
         rendering = RenderSettings(**size, max_depth=args.max_depth, filter=args.filter, backend=args.backend,
-                                   shading=shading)
+                                   device=args.device, shading=shading)
         # every check a long job could fail at its end, on the client, before any task
         loaded, jobs, dims = {}, [], None
         for sname in scenes_arg:
@@ -939,6 +1067,11 @@ def run(args) -> int:
                 raise ValueError(f"{out / 'study.csv'} holds {r['scene']} rows but study.json no reference for "
                                  "them; give another --out")
         refs = plan_references(args, out, loaded, settings, rows, dims, rendering, pass_spp)
+        # no file the study writes (study.csv is appended to) may be one it reads, by any link or spelling
+        check_not_inputs([("--out", out / f) for f in ("study.csv", "study.json", "study.md", "study.png",
+                                                       *(f"study-{n}.png" for n in loaded))],
+                         [(f"{n}'s reference{v}", p) for n, r in refs.items()
+                          for v, p in (("", r.path), (" variance", variance_path(r.path)))])
         # the variance files of the references at hand (a given one's too)
         noise = {n: reference_noise(r.path, r.pixels, crop) for n, r in refs.items() if r.pixels is not None}
         # every check made: now the rows the run appends to, as the catalogue spells them, once each
@@ -971,7 +1104,10 @@ def run(args) -> int:
                 if ref.made_with is not None:
                     rec.update(ref.made_with)
                 elif not is_reference(rec.get("reference"), ref.path, ref.pixels):
-                    rec.update(reference_spp=None, reference_passes=None)  # a given image, not one rendered here
+                    # a given image, not one rendered here: its passes as its header records them
+                    rec.update(reference_spp=None, reference_passes=header_passes(ref.path))
+                elif rec.get("reference_passes") is None:  # recorded by a pyoa that did not read the header
+                    rec.update(reference_passes=header_passes(ref.path))
                 images[name] = ref.pixels.astype(np.float64)
                 shown = ref.path.name if ref.path.resolve().parent == out.resolve() else str(ref.path)  # DIR's own
                 rec.update(reference=identity, reference_name=shown,
@@ -1007,7 +1143,7 @@ def run(args) -> int:
         place = {(s, n): k for k, (s, n) in enumerate((s, n) for s in loaded for n in names)}
         mine.sort(key=lambda r: (place.get((r["scene"], r["sampler"]), len(place)), r["spp_asked"], r["seed"]))
         md = report(settings, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in settings["runs"]),
-                    where=where)
+                    where=where, labels=sampler_labels(args.samplers))
         with atomic_path(out / "study.md") as tmp:
             tmp.write_text(md)
         table = cells(mine, noise)
@@ -1031,32 +1167,36 @@ def interrupted(args) -> str:
 
 def add_parser(sub) -> None:
     """``pyoa study`` on the command line."""
+    from .cli import add_sampling_options
     from .cluster import add_arguments
     from .render.render import SHADINGS
 
     p = sub.add_parser("study", help="error against spp over seeds, with confidence intervals (renders, CSV, "
                                      "report, figures)")
     p.add_argument("scenes", nargs="+", metavar="SCENE", help="bundled scene names or .json files")
-    p.add_argument("--samplers", default=",".join(DEFAULT_SAMPLERS),
-                   help=f"comma-separated sampler names, or all (default {','.join(DEFAULT_SAMPLERS)})")
+    p.add_argument("--samplers", default=",".join(catalogue.DEFAULT_SAMPLERS),
+                   help=f"comma-separated sampler names, or all (default: bose and every comparison sampler, "
+                        f"{','.join(catalogue.DEFAULT_SAMPLERS)})")
     p.add_argument("--spp", default="16,64,256,1024",
                    help="comma-separated sample counts; a sampler without one uses its nearest valid count "
                         "(default 16,64,256,1024)")
     p.add_argument("--seeds", type=int, default=8, help="renders per (scene, sampler, spp), seeds --seed, "
                                                          "--seed+1, ... (default 8)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
-    p.add_argument("--reference", nargs="+", default=None, metavar="REF.exr",
-                   help="one reference image per scene, in the scenes' order")
+    p.add_argument("--reference", action="append", default=None, metavar="SCENE=REF.exr",
+                   help="the reference image of a scene; repeat it for each scene (REF.exr alone when the study "
+                        "has one scene)")
     p.add_argument("--reference-spp", type=int, default=None, metavar="N",
                    help="render the references (pyoa reference, sobol passes) with N spp into DIR")
     p.add_argument("--pass-spp", type=int, default=256, help="samples per reference pass (default 256)")
-    p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None, help="image size (default: "
-                                                                                         "the scenes')")
+    p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None,
+                   help="image size (default: the references' when --reference is given, and a --size that "
+                        "differs from theirs is refused; else the scenes')")
     p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
                    help="crop window (default: the quarter-size window at (W/4, H/4))")
     p.add_argument("--max-depth", type=int, default=None, help="longest path in segments (default: the scene's)")
     p.add_argument("--filter", choices=("box", "gaussian"), default="box", help="pixel filter (default box)")
-    p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="sampler backend")
+    add_sampling_options(p)
     p.add_argument("--shading", choices=SHADINGS, default=None, help="numba (default) or numpy")
     p.add_argument("--out", required=True, metavar="DIR", help="directory of study.csv, study.md, the figures "
                                                                "(and the references)")

@@ -240,7 +240,7 @@ def test_cli_bush_and_gf_bose_listing_and_errors(tmp_path, capsys):
     assert code == 0 and [ln.split()[:2] for ln in out.strip().splitlines()[1:]] == [["64", "8"], ["81", "9"]]
     code, _, err = run_cli(["points", "bush", "--spp", "8", "--strength", "3", "--dims", "4",
                             "--out", tmp_path / "x.npy"], capsys)
-    assert code == 2 and "27 (s=3, t=3)" in err and "64 (s=4, t=3)" in err
+    assert code == 2 and "nearest: 27 (s=3, t=3)" in err  # none below 8
     assert not (tmp_path / "x.npy").exists()
 
 
@@ -276,8 +276,8 @@ def test_cli_index2_listing_and_errors(tmp_path, capsys):
     assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == \
         [[str(2 * s * s), str(s), "2", str(2 * s + 1)] for s in (2, 4, 8, 16, 32, 64, 128)]
     code, out, _ = run_cli(["spp", "addelman-kempthorne", "--near", "100"], capsys)
-    assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == [["50", "5", "2", "11"],
-                                                                                   ["98", "7", "2", "15"]]
+    assert code == 0 and [ln.split() for ln in out.strip().splitlines()[1:]] == [["98", "7", "2", "15"],
+                                                                                   ["162", "9", "2", "19"]]
     code, out, _ = run_cli(["spp", "addelman-kempthorne", "--limit", "3"], capsys)
     assert code == 0 and "18 " in out and "... 423 more" in out
     code, _, err = run_cli(["points", "addelman-kempthorne", "--spp", "32", "--out", tmp_path / "x.npy"],

@@ -98,8 +98,8 @@ def test_spp_refuses_what_the_api_refuses(args, words):
 
 
 FIGURE_COUNTS = [
-    ("plot", ["--size", "10"], ["figure size must be an integer in [64, 8192]"]),
-    ("plot", ["--size", "-900"], ["figure size"]),
+    ("plot", ["--figure-width", "10"], ["figure size must be an integer in [64, 8192]"]),
+    ("plot", ["--figure-width", "-900"], ["figure size"]),
     ("plot", ["--pixel", "-1"], ["pixel must be in [0, 4294967295]"]),
     ("plot", ["--dims", "1"], ["2 <= dims <= 16"]),
     ("plot", ["--spp", "0"], ["spp"]),
@@ -107,7 +107,7 @@ FIGURE_COUNTS = [
     ("spectrum", ["--trials", "0"], ["trials must be in [1, 100000], got 0"]),
     ("spectrum", ["--trials", "-64"], ["trials"]),
     ("spectrum", ["--freq", "0"], ["freq must be in [4, 512], got 0"]),
-    ("spectrum", ["--size", "0"], ["figure size"]),
+    ("spectrum", ["--figure-width", "0"], ["figure size"]),
     ("spectrum", ["--pair", "0,-1"], ["dims must be >= 0"]),
     ("spectrum", ["--pair", "1,1"], ["two different dimensions"]),
 ]

@@ -5,13 +5,14 @@ from __future__ import annotations
 import csv
 import io
 import math
+import sys
 from pathlib import Path
 
 from .. import catalogue
 from ..analysis.statistics import corrected, mean_ci, ratio_ci, relmse_noise
-from ..atomic import atomic_path
+from ..atomic import atomic_path, check_not_inputs
 from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
-from ..cli import DEFAULT_SPP, resolve_spp
+from ..cli import DEFAULT_SPP, add_sampling_options, resolve_spp
 from ..cluster import add_arguments as add_engine_arguments
 from ..cluster import check_engine, engine
 from ..units import format_interval, format_rate, format_ratio
@@ -80,10 +81,10 @@ def _check_job_memory(p, what: str) -> None:
 
 def _settings(args, sampler: str, spp: int, seed: int | None = None, base: int | None = None) -> RenderSettings:
     """The render settings of a command's options (``--size``, ``--max-depth``, ``--filter``, ``--first``,
-    ``--backend``, ``--shading``) for ``sampler`` at ``spp`` (``seed``: ``--seed`` unless given)."""
+    ``--backend``, ``--device``, ``--shading``) for ``sampler`` at ``spp`` (``seed``: ``--seed`` unless given)."""
     return RenderSettings(sampler=sampler, spp=spp, seed=args.seed if seed is None else seed, **_size(args),
                           max_depth=args.max_depth, filter=args.filter, first=args.first, backend=args.backend,
-                          shading=args.shading, base=base)
+                          device=args.device, shading=args.shading, base=base)
 
 
 def _plan(scene, args, sampler: str, spp: int, seed: int | None = None, base: int | None = None):
@@ -110,6 +111,10 @@ def cmd_render(args) -> int:
         check_output(args.png, "--png", PNG)
     if args.progressive:
         check_state_file(state_path(args.out), "where a progressive render keeps its running sum")
+    outputs = [("--out", args.out), ("--png", args.png)]
+    if args.progressive:  # written at every doubling
+        outputs.append(("--out (its running sum)", state_path(args.out)))
+    check_not_inputs(outputs, _reference_inputs(args.reference))
     check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.spp, base=args.base)
@@ -157,6 +162,14 @@ def cmd_render(args) -> int:
     return 0
 
 
+def _reference_inputs(reference) -> list[tuple[str, object]]:
+    """The files a command given ``--reference`` reads: the image and its variance file
+    (:func:`~pyoa.render.reference.variance_path`), as :func:`pyoa.atomic.check_not_inputs` takes them."""
+    if not reference:
+        return []
+    return [("--reference", reference), ("--reference's variance file", variance_path(reference))]
+
+
 def relmse_line(image, ref, crop, noise, reference) -> str:
     """``pyoa render --reference``'s result: the relMSE (and the crop's), with the reference's own
     noise subtracted where its variance file gives it, and said where it does not."""
@@ -196,19 +209,24 @@ def check_seeds(seed, seeds) -> list[int]:
 
 
 def cmd_compare(args) -> int:
-    names = [n.strip() for n in args.samplers.split(",") if n.strip()]
-    if not names:
+    typed = [n.strip() for n in args.samplers.split(",") if n.strip()]
+    if not typed:
         raise ValueError(f"--samplers {args.samplers!r} names no sampler; give a comma-separated list such as "
                          "bose,sobol (see pyoa samplers)")
-    for n in names:
-        catalogue.get(n)  # unknown names fail before any rendering
+    # each sampler once, as typed (unknown names fail here, before any rendering): the tables show the
+    # catalogue's name with an alias beside it, the CSV the catalogue's name (catalogue.shown)
+    labels = {}
+    for n in typed:
+        labels.setdefault(catalogue.get(n).name, catalogue.shown(n))
+    names = list(labels)
     _check_counts(args)
     seeds = check_seeds(args.seed, args.seeds)
     md_path, csv_path, png_path = _compare_outputs(args.out)
+    check_not_inputs([("--out", path) for path in (md_path, csv_path, png_path)], _reference_inputs(args.reference))
     if args.size is None:  # the reference fixes the size: it need not be repeated
         from .image import image_info
 
-        args.size = list(image_info(args.reference)[:2])
+        args.size = list(image_info(args.reference, "--reference")[:2])
     scene = load(args.scene)
     jobs = []
     for name in names:  # every sampler's render is checked before the first one starts
@@ -226,11 +244,10 @@ def cmd_compare(args) -> int:
     with engine(args.workers, args.scheduler) as eng:
         for name, spp in jobs:
             for seed in seeds:
-                rows.append(_compare_one(eng, scene, args, name, spp, seed, ref, crop, crops))
+                rows.append(_compare_one(eng, scene, args, name, spp, seed, ref, crop, crops, labels[name]))
     md = markdown_table(scene.name, rows, crop, seeds=seeds, noise=noise, reference=args.reference,
-                        asked=args.spp)
-    print(md)
-    with atomic_path(md_path) as tmp:
+                        asked=args.spp, labels=labels)
+    with atomic_path(md_path) as tmp:  # the files first: printing cannot lose them (a closed pipe, Ctrl-C)
         tmp.write_text(md)
     with atomic_path(csv_path) as tmp:
         buf = io.StringIO()
@@ -239,22 +256,26 @@ def cmd_compare(args) -> int:
         wr.writerows(rows)
         tmp.write_text(buf.getvalue())
     compare_figure(png_path, crops, ref, crop)
+    print(md)
     if not args.quiet:
         print(f"-> {md_path}, {csv_path}, {png_path}")
     return 0
 
 
-def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, crops: list) -> dict:
-    """Render one sampler and seed of ``pyoa compare`` on ``eng``: its CSV row; what the figure shows of
-    each sampler's first seed (:func:`figure_panels`) is appended to ``crops``."""
+def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, crops: list,
+                 label: str | None = None) -> dict:
+    """Render one sampler (its catalogue name ``name``, shown as ``label``) and seed of ``pyoa compare`` on
+    ``eng``: its CSV row; what the figure shows of each sampler's first seed (:func:`figure_panels`) is
+    appended to ``crops``."""
+    label = label or name
     res = render_on(eng, scene, _settings(args, name, spp, seed), progress=not args.quiet)
     check_finite(res.image, f"the {name} render ({spp} spp, seed {seed})")  # a NaN relMSE is no answer
     row = dict(sampler=name, spp_asked=args.spp, spp=spp, seed=seed, relmse=rel_mse(res.image, ref),
                relmse_crop=rel_mse(res.image, ref, crop), seconds=round(res.seconds, 3))
     if seed == args.seed:
-        crops.append((name, spp, figure_panels(res.image, ref, crop)))
+        crops.append((label, spp, figure_panels(res.image, ref, crop)))
     if not args.quiet:
-        print(f"{name:12s} {spp:6d} spp  seed {seed:<4d} relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
+        print(f"{label:12s} {spp:6d} spp  seed {seed:<4d} relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
               f"({res.seconds:.1f} s)")
     return row
 
@@ -264,11 +285,14 @@ def _default_crop(shape):
     return (w // 4, h // 4, max(1, w // 4), max(1, h // 4))
 
 
-def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], noise, reference, asked: int) -> str:
+def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], noise, reference, asked: int,
+                   labels: dict | None = None) -> str:
     """The report of ``pyoa compare``: per sampler, the mean relMSE over seeds less the reference's own
     noise (:func:`~pyoa.render.reference.reference_noise`), with its 95 % Student-t interval
     (:func:`~pyoa.analysis.statistics.mean_ci`) and its ratio to the first sampler's
-    (:func:`~pyoa.analysis.statistics.ratio_ci`), as ``pyoa study`` computes them."""
+    (:func:`~pyoa.analysis.statistics.ratio_ci`), as ``pyoa study`` computes them. ``labels`` maps a
+    row's sampler to the name the table shows (:func:`pyoa.catalogue.shown`; default: the row's)."""
+    labels = labels or {}
     import numpy as np
 
     x, y, w, h = crop
@@ -293,10 +317,11 @@ def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], nois
              " (one seed: no interval; give --seeds 2 or more for intervals)")
     lines = [f"Scene `{scene}`, {seeds_say}; relMSE = mean of (image - ref)^2 / (ref^2 + 0.01).", "",
              f"Reference `{Path(reference).name}`: {ref_say}.", "",
-             f"{cells}. The ratio is the image relMSE's to {first}'s" +
+             f"{cells}. The ratio is the image relMSE's to {labels.get(first, first)}'s" +
              (" (below 1: less error), with its 95 % interval (delta method on the log ratio, Student's t)."
               if len(seeds) > 1 else " (below 1: less error)."), "",
-             f"| sampler | spp | relMSE (image) | relMSE (crop {w}x{h} at {x},{y}) | / {first} | seconds |",
+             f"| sampler | spp | relMSE (image) | relMSE (crop {w}x{h} at {x},{y}) | "
+             f"/ {labels.get(first, first)} | seconds |",
              "|---|---:|---:|---:|---:|---:|"]
     for name, rs in by.items():
         spp = rs[0]["spp"]
@@ -309,7 +334,7 @@ def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], nois
             cells_.append(format_interval(corrected(m, n), corrected(lo, n), corrected(hi, n)))
         ratio = "1" if name == first else format_ratio(*ratio_ci(image, base, shift_a=nz[0], shift_b=nz[0]))
         secs = sum(r["seconds"] for r in rs) / len(rs)
-        lines.append(f"| {name} | {spp_cell} | {cells_[0]} | {cells_[1]} | {ratio} | {secs:.2f} |")
+        lines.append(f"| {labels.get(name, name)} | {spp_cell} | {cells_[0]} | {cells_[1]} | {ratio} | {secs:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -339,10 +364,18 @@ def figure_panels(image, ref, crop) -> tuple:
 
 
 def compare_figure(path, panels, ref, crop) -> None:
-    """``pyoa compare``'s PNG, as papers show sampler comparisons: per sampler (its first seed) the full
-    image with the crop outlined, the crop at full resolution, and the per-pixel error map in false
-    colour on one logarithmic scale for every sampler, with its colour bar; the reference's image and
-    crop in the last column. Written atomically (matplotlib's Agg canvas)."""
+    """``pyoa compare``'s PNG (:func:`comparison_figure`), written atomically."""
+    fig = comparison_figure(panels, ref, crop)
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fig.savefig(fh, format="png")
+
+
+def comparison_figure(panels, ref, crop):
+    """``pyoa compare``'s figure (matplotlib's Agg canvas), as papers show sampler comparisons: per
+    sampler (its first seed) the full image with the crop outlined, the crop at full resolution, and
+    the per-pixel error map in false colour on one logarithmic scale for every sampler; the
+    reference's image and crop in the last column, and the error maps' colour bar beside the last
+    map, in the reference's empty error cell."""
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import LogNorm
@@ -359,7 +392,7 @@ def compare_figure(path, panels, ref, crop) -> None:
     lo, hi = (float(np.percentile(pos, 1)), float(np.percentile(pos, 99.5))) if pos.size else (1e-6, 1.0)
     norm = LogNorm(vmin=lo, vmax=max(hi, lo * 10))
     cols = len(panels) + 1
-    fig = Figure(figsize=(2.4 * cols + 0.8, 7.4), dpi=100, layout="constrained")
+    fig = Figure(figsize=(2.4 * cols + 0.3, 7.4), dpi=100, layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(3, cols, squeeze=False)
     shown = None
@@ -381,9 +414,21 @@ def compare_figure(path, panels, ref, crop) -> None:
     axes[1][0].set_ylabel(f"crop {w} x {h} at ({x}, {y})", fontsize=9)
     axes[2][0].set_ylabel("relative squared error", fontsize=9)
     if shown is not None:
-        fig.colorbar(shown, ax=axes[2, :].tolist(), shrink=0.9, label="(I - R)^2 / (R^2 + 0.01)")
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        fig.savefig(fh, format="png")
+        # The bar stands beside the last error map, as tall as it, in the reference's empty error cell: a
+        # bar for the whole row took a margin of its own, right of that empty cell. Its place is given
+        # in the map's axes units, so it follows the map's aspect; widths scale with a tall map's h / w.
+        last = shown.axes
+        eh, ew = shown.get_array().shape[:2]
+        u = max(1.0, eh / ew)
+        cax = last.inset_axes([1.0 + 0.04 * u, 0.0, 0.07 * u, 1.0])
+        cax.set_in_layout(False)  # it and its label lie in the empty cell: no margin of their own
+        fig.colorbar(shown, cax=cax, label="(I - R)^2 / (R^2 + 0.01)")
+    return fig
+
+
+#: ``pyoa reference``'s default --spp and --pass-spp; without them a sampler takes its valid pass count nearest
+#: PASS_SPP, and the whole passes nearest REFERENCE_SPP (said on stderr), as ``render`` takes its --spp.
+REFERENCE_SPP, PASS_SPP = 4096, 256
 
 
 def cmd_reference(args) -> int:
@@ -394,10 +439,26 @@ def cmd_reference(args) -> int:
     not hold a valid partial sum, is not resumed: the run starts over and says
     why. Besides OUT, writes OUT's per-pixel variance (``NAME.variance.exr``)."""
     _check_counts(args, spp=False)
-    check_int("--pass-spp", args.pass_spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
+    entry = catalogue.get(args.sampler)
+    pass_given = args.pass_spp is not None
+    if pass_given:  # a count given is exact: refused, naming the option, with the nearest valid ones
+        check_int("--pass-spp", args.pass_spp, 1, MAX_SPP, " (the samplers' limit, 2^24)")
+        try:
+            entry.resolve(args.pass_spp, None, None)
+        except ValueError as exc:
+            raise ValueError(f"--pass-spp {args.pass_spp}: {exc}") from None
+    else:  # the default, as render's --spp: the sampler's valid count nearest it, said on stderr
+        args.pass_spp = resolve_spp(args, args.sampler, PASS_SPP, option="pass_spp")
+    if args.spp is None:  # the default: the whole passes nearest REFERENCE_SPP samples
+        args.spp = max(1, round(REFERENCE_SPP / args.pass_spp)) * args.pass_spp
+        if args.spp != REFERENCE_SPP and not args.quiet:
+            print(f"pyoa reference: {REFERENCE_SPP} samples are not whole passes of {args.pass_spp}; using "
+                  f"{args.spp}, {args.spp // args.pass_spp} passes (give --spp to choose)", file=sys.stderr)
     check_int("--spp", args.spp, 1)
     if args.spp % args.pass_spp:
-        raise ValueError(f"--spp ({args.spp}) must be a multiple of --pass-spp ({args.pass_spp})")
+        default = "the default" if args.pass_spp == PASS_SPP else f"{entry.name}'s valid count nearest the default {PASS_SPP}"
+        why = "" if pass_given else f", {default}; give --pass-spp, a valid count of {entry.name} that divides {args.spp}"
+        raise ValueError(f"--spp ({args.spp}) must be a multiple of --pass-spp ({args.pass_spp}{why})")
     passes = args.spp // args.pass_spp
     check_int("--spp / --pass-spp (passes)", passes, 1, MAX_PASSES, " (pass seeds hash a uint32 index)")
     check_output(args.out, "--out", EXR)
@@ -405,6 +466,8 @@ def cmd_reference(args) -> int:
     check_state_file(state_path(args.out), "where pyoa reference keeps its running sum")
     check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
+    check_not_inputs([("--out", args.out), ("--out (its variance)", variance_path(args.out)),
+                      ("--out (its running sum)", state_path(args.out))], [("the scene file", scene.path)])
     p = _plan(scene, args, args.sampler, args.pass_spp)
     _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
     key = reference_key(scene, p, pass_spp=args.pass_spp, passes=passes, seed=args.seed)
@@ -435,25 +498,28 @@ def cmd_info(args) -> int:
     import json
 
     from .image import image_info
-    from .provenance import read
+    from .provenance import json_value, printable, read
 
     found = {}
     for path in args.files:  # every file is read before anything is printed: one bad name, one error
         found[path] = (image_info(path), read(path))
-    if args.json:
-        print(json.dumps({str(p): dict(meta, width_px=info[0], height_px=info[1], channels=info[2])
-                          for p, (info, meta) in found.items()}, indent=2))
+    if args.json:  # strict JSON (allow_nan=False): a foreign header's NaN is a string, never a bare NaN
+        print(json.dumps({str(p): dict({k: json_value(v) for k, v in meta.items()}, width_px=info[0],
+                                       height_px=info[1], channels=info[2])
+                          for p, (info, meta) in found.items()}, indent=2, allow_nan=False))
         return 0
+    # header strings (and file names) are anyone's: their control characters are printed escaped, so that
+    # a newline cannot forge a line below and an ESC cannot drive the terminal
     for path, ((w, h, c, fmt), meta) in found.items():
-        print(f"{path}: {w} x {h}, {c} channels ({fmt})")
+        print(f"{printable(path)}: {w} x {h}, {c} channels ({printable(fmt)})")
         if not meta:
             print("  no pyoa metadata (not an image of pyoa render, reference or study, or one from before they "
                   "kept it)")
             continue
         keys = [k for k in INFO_ORDER if k in meta] + sorted(k for k in meta if k not in INFO_ORDER)
-        width = max(map(len, keys))
+        width = max(len(printable(k)) for k in keys)
         for k in keys:
-            print(f"  {k:{width}s}  {meta[k]}")
+            print(f"  {printable(k):{width}s}  {printable(meta[k])}")
     return 0
 
 
@@ -477,18 +543,17 @@ def reference_interrupted(args) -> str:
 def add_parsers(sub) -> None:
     """Add ``render``, ``compare`` and ``reference`` to the ``pyoa`` command line."""
 
-    def common(p, spp, spp_help=None):
+    def common(p, spp, spp_help=None, size_help="image size (default: the scene's)"):
         p.add_argument("scene", help="a bundled scene name (cornell, dof7d, bounce9d, deep) or a .json file")
         p.add_argument("--spp", type=int, default=spp, help=spp_help or f"samples per pixel (default {spp})")
         p.add_argument("--seed", type=int, default=0, help="sampler seed (default 0)")
-        p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None,
-                       help="image size (default: the scene's)")
+        p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None, help=size_help)
         p.add_argument("--max-depth", type=int, default=None,
                        help="longest path in segments, as Mitsuba's max_depth (default: the scene's)")
         p.add_argument("--filter", choices=("box", "gaussian"), default="box", help="pixel filter (default box)")
         p.add_argument("--first", type=lambda s: [t for t in s.split(",") if t], default=None,
                        help="integrand dimensions to put in the first sampler dimensions, e.g. light1,lens")
-        p.add_argument("--backend", choices=("opencl", "numpy"), default=None, help="sampler backend")
+        add_sampling_options(p)
         p.add_argument("--shading", choices=SHADINGS, default=None,
                        help="numba: compiled shading calling Embree (default); numpy: the NumPy reference "
                             "(default: $PYOA_SHADING, else numba)")
@@ -517,9 +582,11 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser("compare", help="render with several samplers and tabulate relMSE against a reference")
     common(p, DEFAULT_SPP, f"samples per pixel (default {DEFAULT_SPP}); each sampler renders its valid count "
-                           "nearest it, shown in the table")
-    p.add_argument("--samplers", default=",".join(["bose", *catalogue.names("baseline")]),
-                   help="comma-separated sampler names (default: bose and every comparison sampler)")
+                           "nearest it, shown in the table",
+           "image size (default: the reference's, and a --size that differs from it is refused)")
+    p.add_argument("--samplers", default=",".join(catalogue.DEFAULT_SAMPLERS),
+                   help=f"comma-separated sampler names (default: bose and every comparison sampler, "
+                        f"{','.join(catalogue.DEFAULT_SAMPLERS)})")
     p.add_argument("--reference", required=True, help="reference EXR (pyoa reference SCENE); its size is the "
                                                       "render's unless --size is given")
     p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
@@ -537,8 +604,9 @@ def add_parsers(sub) -> None:
     p.set_defaults(func=cmd_info)
 
     p = sub.add_parser("reference", help="render a high-spp reference in resumable passes")
-    common(p, 4096)
+    common(p, None, f"samples per pixel (default {REFERENCE_SPP}, or the whole passes nearest it)")
     p.add_argument("--sampler", default="sobol", help="sampler of each pass (default sobol)")
-    p.add_argument("--pass-spp", type=int, default=256, help="samples per pass (default 256)")
+    p.add_argument("--pass-spp", type=int, default=None,
+                   help=f"samples per pass (default {PASS_SPP}, or the sampler's valid count nearest it)")
     p.add_argument("--out", default="reference.exr", help="EXR output (default reference.exr)")
     p.set_defaults(func=cmd_reference, interrupted=reference_interrupted)

@@ -64,6 +64,10 @@ MAX_PIXELS = MAX_UINT32 + 1
 #: 1M-triangle meshes with numba and NumPy shading; 512 with a margin. (The
 #: load's own peak is pyoa.render.scene.MESH_TRIANGLE_BYTES.)
 SCENE_TRIANGLE_BYTES = 512
+#: What the first render with numba's cache empty says before numba compiles the renderer: the one
+#: statement of how long that takes, which the README and docs repeat (tests/test_figures_docs.py
+#: checks them against this line; docs/rendering.md, "First use", says when the cache is empty).
+COMPILING = "compiling the renderer with numba (once per installed version of pyoa, 15-60 s) ..."
 #: Shading implementations: numba-compiled with Embree called from it (the
 #: default), or the NumPy reference.
 SHADINGS = ("numba", "numpy")
@@ -258,7 +262,7 @@ def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | Non
     # size; pixels are numbered row-major, y * width + x, as render() does
     image = {"resolution": (width, height)} if catalogue.get(s.sampler).needs_resolution else {}
     smp = make_sampler(s.sampler, spp=s.spp, dims=max(layout.dims, 1), seed=s.seed, backend=s.backend,
-                       max_bytes=limit, base=s.base, **image)
+                       device=s.device, max_bytes=limit, base=s.base, **image)
     # the scene's tracer (Embree's BVH) counts too: it is built before the first sample
     traced = scene_bytes(scene)
     nbytes = traced + render_bytes(width, height, smp.spp, smp.dims, batch_paths=batch_paths, threads=threads)
@@ -324,7 +328,7 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
     ----------
     settings : RenderSettings, optional
         What to render: the sampler, ``spp``, seed, film size, path length,
-        filter, layout, base, backend, shading, batch size and memory limit
+        filter, layout, base, backend, device, shading, batch size and memory limit
         (:class:`~pyoa.render.settings.RenderSettings`, whose docstring
         says what each means). Its fields may also be given as keyword
         arguments, which replace those of ``settings``:
@@ -444,8 +448,7 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
         # freeze the bar at its first step with an ETA of minutes. Said when it is the long one.
         compiling = getattr(integ, "needs_compiling", lambda: False)()
         if compiling:
-            print("compiling the renderer with numba (once per installed version of pyoa, 15-60 s) ...",
-                  file=sys.stderr, flush=True)
+            print(COMPILING, file=sys.stderr, flush=True)
         (p0, p1), batches = batches[0], batches[1:]
         total.add(run((p0, p1)))
         if compiling:
@@ -453,10 +456,10 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
         if outer is not None:
             outer.update(n * (p1 - p0) / (width * height))
         else:
-            from tqdm.auto import tqdm
+            from ..progress import bar as progress_bar
 
             what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
-            bar = tqdm(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {smp.name} {what}")
+            bar = progress_bar(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {smp.name} {what}")
     workers = max(1, min(threads or os.cpu_count() or 1, len(batches)))
 
     def done(batch, future):

@@ -49,6 +49,10 @@ class RenderSettings:
     backend : str, optional
         Sampler backend (``"opencl"``, ``"numpy"``; None: automatic). Every
         backend gives the same bits.
+    device : str, optional
+        OpenCL device selector of the sampler (:func:`pyoa.sampler`'s
+        ``device``; None: ``$PYOA_OPENCL_DEVICE``, else automatic). Every
+        device gives the same bits.
     shading : {"numba", "numpy"}, optional
         The compiled shading or the NumPy reference; None: ``$PYOA_SHADING``,
         else ``"numba"`` (:func:`pyoa.render.render.resolve_shading`).
@@ -81,6 +85,7 @@ class RenderSettings:
     first: tuple[str, ...] | None = None
     base: int | None = None
     backend: str | None = None
+    device: str | None = None
     shading: str | None = None
     batch_paths: int = BATCH_PATHS
     max_bytes: int | str | None = None
