@@ -30,6 +30,7 @@ MIN_EXAMPLES = {
     "pyoa.analysis.rates": 2,
     "pyoa.analysis.spectra": 3,
     "pyoa.analysis.statistics": 12,
+    "pyoa.analysis._display": 2,
     "pyoa.qmc": 20,
 }
 

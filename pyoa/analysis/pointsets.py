@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._checks import _int, _points, _unit_values
+from ._display import Markdown, field_table
 
 __all__ = ["MAX_SUBSETS", "StratificationReport", "cells", "discrepancy", "latin_hypercube", "stratification"]
 
@@ -126,7 +127,8 @@ class StratificationReport:
         ``max |count - N/s**t|`` over every cell of every subset and set (0
         when every subset is stratified).
 
-    A report is true (``bool(report)``) exactly when :attr:`passed`.
+    A report is true (``bool(report)``) exactly when :attr:`passed`; a REPL
+    and a notebook show it as a table (:meth:`table`).
     """
 
     s: int
@@ -164,6 +166,21 @@ class StratificationReport:
             return f"stratified: {head}"
         shown = ", ".join(map(str, self.failing[:8])) + (", ..." if len(self.failing) > 8 else "")
         return f"NOT stratified: {len(self.failing)} of {head} fail (max deviation {self.max_deviation}): {shown}"
+
+    def table(self) -> Markdown:
+        """Markdown: :meth:`__str__`, then the checked values, a field per row."""
+        shown = ", ".join(map(str, self.failing[:8])) + (", ..." if len(self.failing) > 8 else "")
+        return field_table(str(self), [
+            ("cells per axis, s", self.s), ("subset size, t", self.t), ("points per set, N", self.n_points),
+            ("point sets", self.n_sets), ("dimensions", ", ".join(map(str, self.dims))),
+            ("subsets checked", self.n_subsets), ("subsets failing", f"{len(self.failing)}: {shown}" if shown else 0),
+            ("max deviation", self.max_deviation)])
+
+    def __repr__(self) -> str:
+        return repr(self.table())
+
+    def _repr_markdown_(self) -> str:
+        return str(self.table())
 
 
 def stratification(points, s: int, t: int, *, dims: Iterable[int] | None = None) -> StratificationReport:

@@ -33,6 +33,7 @@ import numpy as np
 from ..catalogue import nearest_spp
 from ..samplers import trial_options
 from ._checks import _dim, _int
+from ._display import Markdown
 from .integrands import Integrand, _lookup
 from .statistics import fit_loglog
 
@@ -72,6 +73,8 @@ class ConvergenceResult:
         Strength asked of ``bush``/``cmjnd`` (None for the others).
     skipped : dict of str to str
         Samplers left out, with the reason (e.g. no valid count for d dimensions).
+
+    A REPL and a notebook show the result as its :meth:`table`.
     """
 
     integrand: Integrand
@@ -93,9 +96,10 @@ class ConvergenceResult:
         """The samplers measured (in the order given)."""
         return list(self.spp)
 
-    def table(self) -> str:
+    def table(self) -> Markdown:
         """Markdown: one row per sampler and count (mean, variance, MSE), then
-        one per sampler with the fitted slopes, then the skipped samplers."""
+        one per sampler with the fitted slopes, then the skipped samplers. A
+        ``str`` that a REPL shows as the table itself (:class:`Markdown`)."""
         f = self.integrand
         lines = [(f"Integrand `{f.name}` (d={self.d}, exact {f.exact:.10g}, coupling {f.coupling}), "
                   f"{self.trials} trials, seed {self.seed}"), "",
@@ -110,7 +114,14 @@ class ConvergenceResult:
         if self.skipped:
             lines += ["", "| skipped | reason |", "|---|---|"]
             lines += [f"| {name} | {why} |" for name, why in self.skipped.items()]
-        return "\n".join(lines) + "\n"
+        return Markdown("\n".join(lines) + "\n")
+
+    def __repr__(self) -> str:
+        # a REPL shows the result as its table, not as a constructor call with every array in it
+        return repr(self.table())
+
+    def _repr_markdown_(self) -> str:
+        return str(self.table())
 
     def plot(self, path, *, metric: str = "variance", dpi: int = 100) -> Path:
         """Write a log-log plot of variance (or MSE) against N, one line per

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..samplers import _int as _checked_int
+from ._display import Markdown, field_table
 from .integrands import _lookup
 
 __all__ = ["ErrorSpectrum", "error_spectrum", "radial_mean"]
@@ -68,6 +69,8 @@ class ErrorSpectrum:
         (neighbouring pixels' errors cancel).
     rmse : float
         Root mean squared per-pixel error.
+
+    A REPL and a notebook show it as a table of the numbers (:meth:`table`).
     """
 
     sampler: str
@@ -80,6 +83,18 @@ class ErrorSpectrum:
     radial: np.ndarray = field(repr=False)
     low: float
     rmse: float
+
+    def table(self) -> Markdown:
+        """Markdown: what was measured and its summary numbers, a field per row."""
+        return field_table(f"Error spectrum of `{self.sampler}` on `{self.integrand}`", [
+            ("spp", self.spp), ("image", f"{self.size} x {self.size}"), ("seeds", self.seeds),
+            ("low-frequency power (white noise = 1)", f"{self.low:.4g}"), ("RMSE per pixel", f"{self.rmse:.4g}")])
+
+    def __repr__(self) -> str:
+        return repr(self.table())
+
+    def _repr_markdown_(self) -> str:
+        return str(self.table())
 
 
 def error_spectrum(sampler: str, *, spp: int, size: int = 64, seeds: int = 8, integrand: str = "ball",
