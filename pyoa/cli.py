@@ -421,16 +421,37 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
               file=sys.stderr if file is None else file)
 
 
+def _open_closed_streams() -> None:
+    """Standard output or error closed when pyoa started (``pyoa ... >&-``): Python makes it None, and
+    the command would fail at its first message with nothing written. Its descriptor gets /dev/null
+    instead, so that the command runs as with that output discarded, and no file the command opens
+    takes descriptor 1 or 2 (where a worker process's output would land in it)."""
+    for fd, name in ((1, "stdout"), (2, "stderr")):
+        if getattr(sys, name) is not None:
+            continue
+        try:
+            os.fstat(fd)
+        except OSError:  # closed: /dev/null takes its number
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            if devnull != fd:
+                os.dup2(devnull, fd)
+                os.close(devnull)
+        setattr(sys, name, open(fd, "w", closefd=False))  # noqa: SIM115 - the process's own stream
+
+
 class _ReaderMayLeave:
     """``sys.stdout`` or ``sys.stderr`` while a command runs. When the reader of the pipe has gone
-    (``pyoa compare ... | head -1``), the rest of what is written goes to /dev/null and the command
-    carries on, so that the work it finishes still reaches its files (a BrokenPipeError would end it
-    with nothing written); :func:`main` then ends with the status of a tool that SIGPIPE ends."""
+    (``pyoa compare ... | head -1``), or the stream cannot be written (``> /dev/full``), the rest of
+    what is written goes to /dev/null and the command carries on, so that the work it finishes still
+    reaches its files (the error would end it with nothing written); :func:`main` then ends with the
+    status of a tool that SIGPIPE ends, or with one line naming the stream's error."""
 
     def __init__(self, stream):
         self.stream = stream
         #: whether the reader has gone
         self.gone = False
+        #: an error other than a closed pipe met while writing (``ENOSPC``...), said at the end
+        self.error: OSError | None = None
 
     def __getattr__(self, name):
         return getattr(self.stream, name)
@@ -438,10 +459,13 @@ class _ReaderMayLeave:
     def _guarded(self, call, *args):
         try:
             return call(*args)
-        except BrokenPipeError:
+        except OSError as exc:
+            if isinstance(exc, BrokenPipeError):
+                self.gone = True
+            elif self.error is None:
+                self.error = exc
             # the stream's descriptor goes to /dev/null, so that what is still buffered, and Python's flush
             # at exit, do not fail again (https://docs.python.org/3/library/signal.html#note-on-sigpipe)
-            self.gone = True
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, self.stream.fileno())
             os.close(devnull)
@@ -458,21 +482,30 @@ def main(argv: list[str] | None = None) -> int:
     """``pyoa ARGS``: run the command, with a one-line message and status 2 for what it refuses. A
     closed standard output (``| head``) neither stops the command nor makes it say anything: it
     finishes, writes its files and ends with 141 = 128 + SIGPIPE, as a shell reports a tool whose
-    reader left."""
+    reader left. Standard output that cannot be written (a full disk) does not stop it either; it
+    ends with one line naming that error and status 2. A stream closed from the start (``>&-``)
+    reads as /dev/null."""
+    _open_closed_streams()
     out, err = _ReaderMayLeave(sys.stdout), _ReaderMayLeave(sys.stderr)
     sys.stdout, sys.stderr = out, err
+    ran: dict = {}
     try:
-        status = _main(argv)
+        status = _main(argv, ran)
     finally:
         out.flush()  # what is still buffered meets a closed pipe here, not in Python's flush at exit
         err.flush()
         sys.stdout, sys.stderr = out.stream, err.stream
+    if out.error is not None and not status:
+        print(f"pyoa {ran.get('command', '')}: error: cannot write standard output: {out.error.strerror or out.error}"
+              " (the command ran to its end; only what it printed is lost)", file=sys.stderr)
+        return 2
     return 128 + 13 if out.gone and not status else status  # 13: SIGPIPE
 
 
-def _main(argv: list[str] | None) -> int:
+def _main(argv: list[str] | None, ran: dict) -> int:
     ap = build_parser()
     args = ap.parse_args(argv)
+    ran["command"] = args.command
     args.argv = list(sys.argv[1:] if argv is None else argv)  # what made an image goes into its header
     try:
         with warnings.catch_warnings():

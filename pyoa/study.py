@@ -556,9 +556,9 @@ def read_rows(path: Path, repair: bool = False) -> list[dict]:
         rows.append(row)
     if repair and (cut or dropped or renamed):
         buf = io.StringIO()
-        writer = csv.DictWriter(buf, fieldnames=FIELDS, lineterminator="\n")
-        writer.writeheader()
-        writer.writerows({k: r[k] for k in FIELDS} for r in rows)
+        write = _record_writer(buf)
+        for r in rows:
+            write(r)
         with atomic_path(path) as tmp:
             tmp.write_text(buf.getvalue(), encoding="utf-8")
         said = []  # a cut line goes without a word, as it always has
@@ -572,6 +572,23 @@ def read_rows(path: Path, repair: bool = False) -> list[dict]:
     return rows
 
 
+def _record_writer(fh, header: bool = True):
+    """A function that writes a row to ``fh`` as one study.csv record (``\\n`` ends it), after the header
+    unless ``header`` is False. A row holding a carriage return is written with every field quoted:
+    before Python 3.12 the csv writer quotes a field for a line break only when the break is in its
+    line terminator, so a scene named ``a\\rb`` was written bare, and read back as two records."""
+    plain = csv.DictWriter(fh, fieldnames=FIELDS, lineterminator="\n")
+    quoted = csv.DictWriter(fh, fieldnames=FIELDS, lineterminator="\n", quoting=csv.QUOTE_ALL)
+    if header:
+        plain.writeheader()
+
+    def write(row: dict) -> None:
+        record = {k: row[k] for k in FIELDS}
+        (quoted if any("\r" in str(v) for v in record.values()) else plain).writerow(record)
+
+    return write
+
+
 class RowWriter:
     """Appends rows to ``study.csv``, one flushed CSV record each (UTF-8; a scene name holding a line break
     or a quote is quoted, as :func:`read_rows` reads it)."""
@@ -579,13 +596,12 @@ class RowWriter:
     def __init__(self, path: Path):
         new = not path.exists() or path.stat().st_size == 0
         self.fh = open(path, "a", newline="", encoding="utf-8")  # noqa: SIM115 - open for the whole study
-        self.writer = csv.DictWriter(self.fh, fieldnames=FIELDS, lineterminator="\n")
+        self.write = _record_writer(self.fh, header=new)
         if new:
-            self.writer.writeheader()
             self.fh.flush()
 
     def add(self, row: dict) -> None:
-        self.writer.writerow({k: row[k] for k in FIELDS})
+        self.write(row)
         self.fh.flush()
         os.fsync(self.fh.fileno())
 
@@ -663,6 +679,8 @@ def _ratio(a: Cell, b: Cell) -> str:
 def headline(table: dict, labels: dict | None = None) -> list[str]:
     """Markdown: per scene and spp, bose / the best padded sampler (of those in ``table``) and bose / sobol
     (``labels``: the names shown, :func:`sampler_labels`)."""
+    from .render.provenance import printable  # a scene name may hold a newline: one table row each
+
     labels = labels or {}
     lines = ["| scene | spp | best padded | bose / best padded | bose / sobol |", "|---|---:|---|---:|---:|"]
     any_row = False
@@ -673,7 +691,7 @@ def headline(table: dict, labels: dict | None = None) -> list[str]:
             best = min(padded, key=lambda cn: cn[0].ci()[0]) if padded else None
             sob = by_sampler.get("sobol", {}).get(asked)
             shown = f"{labels.get(best[1], best[1])} {best[0].spp}" if best else "-"
-            lines.append(f"| {scene} | {c.spp} | {shown} | "
+            lines.append(f"| {printable(scene)} | {c.spp} | {shown} | "
                          f"{_ratio(c, best[0]) if best else '-'} | {_ratio(c, sob) if sob else '-'} |")
             any_row = True
     return lines if any_row else []
@@ -684,6 +702,7 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
     """The Markdown report of a study (see the module docstring); ``seconds``
     the time of every run so far (``settings["runs"]``); ``labels`` the names its tables show
     (:func:`sampler_labels`; default: the catalogue's)."""
+    from .render.provenance import printable
     from .render.reference import variance_path
 
     labels = labels or {}
@@ -712,7 +731,7 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
         else:
             say = (f"its own noise adds an estimated {nz[0]:.2g} to every image relMSE and {nz[1]:.2g} to every "
                    f"crop relMSE (from the per-pixel variance {whence}); both are subtracted below")
-        lines += [f"## {scene}", "", f"Reference `{ref}`: {say}.", ""]
+        lines += [f"## {printable(scene)}", "", f"Reference `{printable(ref)}`: {say}.", ""]
         asked = sorted({a for by in by_sampler.values() for a in by})
         names = [n for n in (samplers or by_sampler) if n in by_sampler]
         for crop in (False, True):

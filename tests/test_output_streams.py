@@ -114,6 +114,36 @@ def test_study_with_its_reader_gone_writes_its_rows_and_report(tmp_path):
     assert (out / "study.md").stat().st_size > 0 and (out / "study.png").stat().st_size > 0
 
 
+@pytest.mark.parametrize("closed", ["stdout", "stderr", "both"])
+def test_a_stream_closed_from_the_start_loses_no_output(tmp_path, reference_8x8, closed):
+    """``pyoa compare ... >&-`` (or ``2>&-``): Python starts with that stream None; the command still
+    renders and writes every file, and ends with 0 (the wrapper of the closed-pipe fix met None with an
+    AttributeError, status 120 and nothing written)."""
+    fds = {"stdout": (1,), "stderr": (2,), "both": (1, 2)}[closed]
+    cmd = pyoa_cmd("compare", "cornell", "--samplers", "bose", "--spp", 4, "--reference", reference_8x8,
+                   "--out", tmp_path / "hq")
+    proc = subprocess.run(cmd, cwd=tmp_path, env=ENV, capture_output=True, timeout=600,
+                          preexec_fn=lambda: [os.close(fd) for fd in fds])
+    assert proc.returncode == 0, (proc.returncode, proc.stderr.decode())
+    for suffix in (".md", ".csv", ".png"):
+        assert (tmp_path / f"hq{suffix}").stat().st_size > 0
+
+
+def test_standard_output_that_cannot_be_written_is_named_once_the_work_is_done(tmp_path, reference_8x8):
+    """``pyoa compare ... > /dev/full``: the renders go on to their files, then one line names standard
+    output's error, status 2 (it said only ``[Errno 28] No space left on device``, with no file written)."""
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run(pyoa_cmd("compare", "cornell", "--samplers", "bose", "--spp", 4, "--reference",
+                                       reference_8x8, "--out", tmp_path / "hq"),
+                              cwd=tmp_path, env=ENV, stdout=full, stderr=subprocess.PIPE, text=True, timeout=600)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines()[-1] == ("pyoa compare: error: cannot write standard output: No space "
+                                                    "left on device (the command ran to its end; only what it "
+                                                    "printed is lost)")
+    for suffix in (".md", ".csv", ".png"):
+        assert (tmp_path / f"hq{suffix}").stat().st_size > 0
+
+
 # --------------------------------------------------------------------------- Ctrl-C on a local cluster (item 9)
 
 def test_ctrl_c_on_a_local_cluster_prints_pyoa_line_only(tmp_path):

@@ -17,7 +17,7 @@ from pyoa import study
 from pyoa.cli import main
 from pyoa.render.scene import bundled
 
-NAMES = ["a\nb", 'say "hi"', "x,y", "été ünï 日本", "cr\rlf\r\n", "\u2028sep", "plain"]
+NAMES = ["a\nb", "cr\rz", 'say "hi"', "x,y", "été ünï 日本", "cr\rlf\r\n", "\u2028sep", "plain"]
 
 
 def row(scene: str, seed: int = 0) -> dict:
@@ -73,6 +73,10 @@ def test_a_study_of_a_scene_whose_name_holds_a_newline_resumes(tmp_path, capsys,
     before = (tmp_path / "D" / "study.csv").read_bytes()
     assert main(argv) == 0  # resumed: nothing left to render, no row added
     assert (tmp_path / "D" / "study.csv").read_bytes() == before
+    # the report names the scene escaped: a table row and a heading stay one line each
+    md = (tmp_path / "D" / "study.md").read_text()
+    assert "## a\\nb" in md and not any(line.startswith('b "c"') for line in md.splitlines()), md
+    assert "\x1b" not in capsys.readouterr().out
 
 
 # -- item 4: damaged files ---------------------------------------------------------------------------

@@ -30,7 +30,7 @@ from .image import (
 )
 from .layout import MAX_DEPTH
 from .progressive import check_progressive, render_progressive, state_path
-from .provenance import command_line, describe
+from .provenance import command_line, describe, printable
 from .reference import reference_key, reference_noise, render_reference, variance_path
 from .render import SHADINGS, check_memory, plan
 from .scene import load
@@ -133,7 +133,7 @@ def cmd_render(args) -> int:
         if not args.quiet:
             base = f" (base {pres.base})" if pres.base else ""
             why = f", stopped by --time {args.time:g}" if pres.stopped_by_time else ""
-            print(f"{scene.name}: {pres.sampler}{base} {pres.samples} of {pres.spp} spp{why}; this run "
+            print(f"{printable(scene.name)}: {pres.sampler}{base} {pres.samples} of {pres.spp} spp{why}; this run "
                   f"{pres.samples - pres.resumed_from} samples in {pres.seconds:.2f} s -> {args.out}"
                   f"{' and ' + args.png if args.png else ''} (running sum in {state_path(args.out)})")
     else:
@@ -147,7 +147,7 @@ def cmd_render(args) -> int:
         image = res.image
         if not args.quiet:
             h, w = res.image.shape[:2]
-            print(f"{scene.name}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
+            print(f"{printable(scene.name)}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
             where = "" if eng.client is None else f" on {eng.description}"
             if res.compiled is None:
                 speed = f"{format_rate(res.paths_per_second)}paths/s, {format_rate(res.rays_per_second)}rays/s"
@@ -315,7 +315,7 @@ def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], nois
              ", ± the half-width of its 95 % Student-t interval" if len(seeds) > 1 else
              "Each cell: one render's relMSE" + (" minus that noise" if noise is not None else "") +
              " (one seed: no interval; give --seeds 2 or more for intervals)")
-    lines = [f"Scene `{scene}`, {seeds_say}; relMSE = mean of (image - ref)^2 / (ref^2 + 0.01).", "",
+    lines = [f"Scene `{printable(scene)}`, {seeds_say}; relMSE = mean of (image - ref)^2 / (ref^2 + 0.01).", "",
              f"Reference `{Path(reference).name}`: {ref_say}.", "",
              f"{cells}. The ratio is the image relMSE's to {labels.get(first, first)}'s" +
              (" (below 1: less error), with its 95 % interval (delta method on the log ratio, Student's t)."
@@ -498,7 +498,7 @@ def cmd_info(args) -> int:
     import json
 
     from .image import image_info
-    from .provenance import json_value, printable, read
+    from .provenance import json_value, read
 
     found = {}
     for path in args.files:  # every file is read before anything is printed: one bad name, one error

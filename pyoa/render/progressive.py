@@ -46,7 +46,7 @@ import numpy as np
 from .. import catalogue
 from .image import check_finite, write_exr, write_png
 from .integrator import RENDERER_VERSION, Stats
-from .provenance import describe
+from .provenance import describe, printable
 from .render import plan, render
 from .settings import RenderSettings
 from .state import (
@@ -299,7 +299,7 @@ def render_progressive(scene, settings: RenderSettings | None = None, /, *, out,
     integrator = None
     block = np.empty_like(total)
     last_rate = None  # seconds per sample of the previous block
-    bar = None if quiet else _Bar(scene.name, smp, done, time_budget, t_start)
+    bar = None if quiet else _Bar(printable(scene.name), smp, done, time_budget, t_start)
     try:
         for end in block_ends(done, smp.spp):
             n = end - done

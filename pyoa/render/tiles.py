@@ -25,6 +25,7 @@ from contextlib import closing
 import numpy as np
 
 from .integrator import Stats
+from .provenance import printable
 from .render import BATCH_PATHS, RenderResult, plan, render
 from .scene_source import SceneSource, load_source, source_of
 from .settings import RenderSettings
@@ -101,7 +102,7 @@ def render_on(eng, scene, settings: RenderSettings | None = None, /, *, progress
     t0 = time.perf_counter()
     src = eng.share(src)
     with closing(eng.run(tile_task, [(src, settings, t, threads) for t in tiles], key="pyoa-tile")) as results:
-        for _, (start, means, st) in progress_over(results, len(tiles), f"{scene.name} {p.sampler.name} "
+        for _, (start, means, st) in progress_over(results, len(tiles), f"{printable(scene.name)} {p.sampler.name} "
                                                    f"{p.sampler.spp} spp", not progress, unit="tile"):
             out[start:start + len(means)] = means
             stats.add(st)
