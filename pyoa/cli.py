@@ -30,6 +30,8 @@ from .catalogue import get
 from .catalogue_types import MAX_UINT32, SppChoice, check_int
 from .cluster import TasksLost
 from .plots import FIGURE_WIDTH
+from .plots import MAX_SIZE as MAX_FIGURE_WIDTH
+from .plots import MIN_SIZE as MIN_FIGURE_WIDTH
 from .samplers import ENV_MAX_BYTES, trial_options
 
 #: The samples per pixel of every command that is given no ``--spp`` (``pyoa reference`` aside).
@@ -82,10 +84,13 @@ def figure_width(args) -> int:
         raise ValueError(f"two figure widths given: --figure-width {args.figure_width} and --size "
                          f"{args.size_old}; give one, as --figure-width PX")
     if args.size_old is not None:
+        check_int("--size", args.size_old, MIN_FIGURE_WIDTH, MAX_FIGURE_WIDTH, " (pixels)")
         deprecated(args.command, f"--size {args.size_old}",
                    f"--figure-width {args.size_old} (--size is W H of an image in every other command)")
         return args.size_old
-    return FIGURE_WIDTH if args.figure_width is None else args.figure_width  # checked by pyoa.plots
+    if args.figure_width is None:
+        return FIGURE_WIDTH
+    return check_int("--figure-width", args.figure_width, MIN_FIGURE_WIDTH, MAX_FIGURE_WIDTH, " (pixels)")
 
 
 def resolve_spp(args, name: str, default: int = DEFAULT_SPP, option: str = "spp") -> int:
@@ -193,7 +198,7 @@ def cmd_points(args) -> int:
                "base": args.base}
     smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, **trial_options(args.sampler, options))
     # One value first: it pays the one-time costs (the backend's kernel build, a table such as pmj02's,
-    # built once per machine), so that the rate below is the generation's alone, as render's is.
+    # built once and cached), so that the rate below is the generation's alone, as render's is.
     t0 = time.perf_counter()
     smp.generate(pixels=pixels[:1], samples=range(1), dims=range(1))
     setup = time.perf_counter() - t0
@@ -203,7 +208,7 @@ def cmd_points(args) -> int:
     save_points(x, args.out, pixels)
     if not args.quiet:
         print(smp)
-        print(f"{x.size:,} values ({x.shape[0]} pixels x {x.shape[1]} samples x {x.shape[2]} dims) "
+        print(f"{x.size:,} values ({x.shape[0]} pixel{'s' * (x.shape[0] != 1)} x {x.shape[1]} samples x {x.shape[2]} dims) "
               f"in {_seconds(dt)} ({format_rate(x.size / max(dt, 1e-9))} values/s), after {_seconds(setup)} of "
               f"one-time setup (kernels, tables) -> {args.out}")
     return 0
@@ -231,6 +236,10 @@ def _in_base(name: str, choices, base: int, dims: int | None) -> list[SppChoice]
 
 def cmd_spp(args) -> int:
     _option(args, "limit", 1)
+    # named as options here (valid_spp names its keywords: near, dims, strength)
+    for name in ("near", "dims", "strength"):
+        if getattr(args, name) is not None:
+            _option(args, name, 0 if name == "near" else 1)
     # valid_spp refuses --near, --dims and --strength values the sampler cannot have
     choices = valid_spp(args.sampler, near=args.near, dims=args.dims, strength=args.strength)
     shown = choices[: args.limit]
@@ -323,13 +332,23 @@ def cmd_backends(args) -> int:
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser with its usage errors in one line, as every other refusal
+    (``pyoa render: error: unrecognized arguments: --bogus; see pyoa render --help``), not the usage
+    block first; exit status 2 as before."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}; see {self.prog} --help\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
 
-    ap = argparse.ArgumentParser(prog="pyoa", description="Orthogonal-array sampling for Monte Carlo rendering.",
-                                 epilog=CONVENTION, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = _Parser(prog="pyoa", description="Orthogonal-array sampling for Monte Carlo rendering.",
+                 epilog=CONVENTION, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--version", action="version", version=f"pyoa {__version__}")
-    sub = ap.add_subparsers(dest="command", required=True)
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    ap.set_defaults(commands=sub.choices)  # _main: an unknown option is refused by its command's parser
 
     spp_help = (f"samples per pixel (default {DEFAULT_SPP}, or the sampler's valid count nearest it)")
     p = sub.add_parser("points", help="generate a point set and save it (.npy or .csv)")
@@ -504,7 +523,9 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None, ran: dict) -> int:
     ap = build_parser()
-    args = ap.parse_args(argv)
+    args, unknown = ap.parse_known_args(argv)
+    if unknown:  # the command's parser says it, naming the command (the top-level one would say "pyoa")
+        args.commands[args.command].error(f"unrecognized arguments: {' '.join(unknown)}")
     ran["command"] = args.command
     args.argv = list(sys.argv[1:] if argv is None else argv)  # what made an image goes into its header
     try:

@@ -714,7 +714,7 @@ def report(settings: dict, rows: list[dict], noise: dict, *, samplers=None, spp=
     lines = ["# Sampler study", "",
              f"{len(rows)} renders at {w} x {h}, crop {cw} x {ch} at ({x}, {y}); relMSE = mean of "
              "(image - ref)^2 / (ref^2 + 0.01) (the paper's measure). Each cell: the mean over seeds of the relMSE "
-             "minus the reference's own noise estimate, ± the half-width of its 95 % Student-t interval over "
+             "minus the reference's own noise estimate where it is known (each scene's section says), ± the half-width of its 95 % Student-t interval over "
              "seeds. The slope is the least-squares fit of log(mean) against log(spp)." +
              (f" Rendered {where if where == 'in-process' else 'on ' + where}." if where else "") +
              (f" It took {seconds:.0f} s in all{runs}." if seconds is not None else ""), ""]
@@ -819,15 +819,17 @@ def figure(table: dict, scenes: list[str], samplers: list[str]):
         lows = [np.min(ln.get_ydata()) for ln in ax.get_lines()]  # the means drawn, all positive
         lows += [v for _, n, lo, hi, keep in series for v in lo[keep & (lo > 0)]]
         floor = min(lows, default=1.0) / 10 ** 0.5
-        cut_any = False
+        cut_any = 0
         for c, n, lo, hi, keep in series:
             band = keep & np.isfinite(lo) & np.isfinite(hi)
             if band.any():
                 ax.fill_between(n[band], np.where(lo > 0, lo, floor)[band], hi[band], color=c, alpha=0.18, lw=0)
             cut = band & ~(lo > 0)
             if cut.any():
-                ax.plot(n[cut], np.full(cut.sum(), floor), ls="none", marker="v", ms=6, color=c, clip_on=False)
-                cut_any = True
+                # each sampler's triangles a step above the last one's: at one count they would hide each other
+                at = floor * 10 ** (0.12 * cut_any)
+                ax.plot(n[cut], np.full(cut.sum(), at), ls="none", marker="v", ms=6, color=c, clip_on=False)
+                cut_any += 1
         if cut_any:
             ax.set_ylim(bottom=floor)
             ax.plot([], [], ls="none", marker="v", ms=6, color="0.4",

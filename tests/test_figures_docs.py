@@ -62,15 +62,19 @@ def test_study_figure_cuts_a_band_that_reaches_zero_and_marks_it():
             assert np.isclose(ys.max(), hi), (name, spp)
             assert np.isclose(ys.min(), lo if lo > 0 else floor), (name, spp)
             assert ys.min() <= m <= ys.max()
-    # a triangle at the floor for each cut count, in its sampler's colour, drawn over the axis line
+    # a triangle at the floor for each cut count, in its sampler's colour, drawn over the axis line; each
+    # sampler's a step above the last one's, so that at one count none hides another
     cut = {(name, spp) for name, by in cis.items() for spp, (m, lo, hi) in by.items() if lo <= 0}
-    marked = set()
+    marked, heights = set(), []
     for line in ax.get_lines():
         if line.get_marker() == "v" and len(line.get_xdata()):
-            assert np.allclose(line.get_ydata(), floor) and not line.get_clip_on()
+            ys = line.get_ydata()
+            assert np.allclose(ys, ys[0]) and floor <= ys[0] < floor * 10 ** 0.5 and not line.get_clip_on()
+            heights.append(ys[0])
             name = "bose" if line.get_color() == ax.get_lines()[0].get_color() else "random"
             marked |= {(name, int(x)) for x in line.get_xdata()}
     assert marked == cut
+    assert len(heights) == 2 and heights[0] != heights[1]  # bose and random each have a cut count
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
     assert any("reaches 0" in t and "cut" in t for t in legend), legend
 

@@ -131,3 +131,39 @@ def test_refusals_name_the_nearest_counts_on_both_sides():
         pyoa.sampler("bose", spp=32, dims=4, backend="numpy")
     assert [c.spp for c in pyoa.valid_spp("random", near=7)] == [6, 7, 8]
     assert [c.spp for c in pyoa.valid_spp("sobol", near=2**24 + 5)] == [2**24]  # nothing above the largest
+
+
+# -- found by the review of these fixes -----------------------------------------------------------
+
+
+@pytest.mark.parametrize("args, option", [(("spp", "bose", "--near", "-5"), "--near"),
+                                          (("spp", "bose", "--dims", "0"), "--dims"),
+                                          (("plot", "bose", "--figure-width", "0", "-q"), "--figure-width"),
+                                          (("spectrum", "bose", "--size", "10", "-q"), "--size")])
+def test_a_refused_option_is_named_as_typed(tmp_path, args, option):
+    """The command line names its options: ``--near must be >= 0`` (it said ``near must be >= 0``, the
+    Python keyword), ``--figure-width must be in [64, 8192]`` (it said ``figure size must be ...``)."""
+    message = refused(pyoa_cli(*args, cwd=tmp_path), args[0])
+    assert message.split(": error: ", 1)[1].startswith(f"{option} must be"), message
+
+
+def test_compare_takes_all_as_study_does(tmp_path):
+    """``--samplers all`` is every sampler in compare as in study (compare said ``unknown sampler 'all'``):
+    here the run goes on to its next check, the missing reference."""
+    message = refused(pyoa_cli("compare", "cornell", "--samplers", "all", "--reference", "missing.exr",
+                               cwd=tmp_path), "compare")
+    assert "all" not in message and "missing.exr" in message, message
+
+
+def test_points_says_one_pixel(tmp_path):
+    res = pyoa_cli("points", "bose", "--spp", "16", "--dims", "2", "--pixels", "1", "--out", "p.npy", cwd=tmp_path)
+    assert res.returncode == 0 and "(1 pixel x 16 samples x 2 dims)" in res.stdout, res.stdout + res.stderr
+
+
+@pytest.mark.parametrize("args, says", [(("render", "cornell", "--bogus"), "unrecognized arguments: --bogus"),
+                                        (("spp", "bose", "--near", "1e9"), "argument --near: invalid int value")])
+def test_a_usage_error_is_one_line_naming_its_command(tmp_path, args, says):
+    """argparse's own refusals are one line led by ``pyoa COMMAND: error:``, as every other (an unknown option
+    printed the whole usage block and ``pyoa: error: unrecognized arguments``)."""
+    message = refused(pyoa_cli(*args, cwd=tmp_path), args[0])
+    assert says in message and message.endswith(f"see pyoa {args[0]} --help"), message

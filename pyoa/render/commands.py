@@ -150,10 +150,10 @@ def cmd_render(args) -> int:
             print(f"{printable(scene.name)}: {w} x {h}, {res.sampler} {res.spp} spp, {res.dims} dims ({res.layout})")
             where = "" if eng.client is None else f" on {eng.description}"
             if res.compiled is None:
-                speed = f"{format_rate(res.paths_per_second)}paths/s, {format_rate(res.rays_per_second)}rays/s"
+                speed = f"{format_rate(res.paths_per_second)} paths/s, {format_rate(res.rays_per_second)} rays/s"
             elif res.stats.paths > res.compiled[1]:  # the first render after an install: its rate without the compile
                 speed = (f"{res.compiled[0]:.1f} s of it compiling the renderer (once), "
-                         f"{format_rate(res.steady_paths_per_second())}paths/s after")
+                         f"{format_rate(res.steady_paths_per_second())} paths/s after")
             else:  # one batch: no rate to give apart from the compile
                 speed = "most of it compiling the renderer (once; the next render is quicker)"
             print(f"{res.seconds:.2f} s{where}, {speed} -> {args.out}{' and ' + args.png if args.png else ''}")
@@ -209,7 +209,9 @@ def check_seeds(seed, seeds) -> list[int]:
 
 
 def cmd_compare(args) -> int:
-    typed = [n.strip() for n in args.samplers.split(",") if n.strip()]
+    # "all": every sampler of the catalogue, as study reads it
+    typed = (list(catalogue.names()) if args.samplers.strip().lower() == "all" else
+             [n.strip() for n in args.samplers.split(",") if n.strip()])
     if not typed:
         raise ValueError(f"--samplers {args.samplers!r} names no sampler; give a comma-separated list such as "
                          "bose,sobol (see pyoa samplers)")
@@ -585,7 +587,7 @@ def add_parsers(sub) -> None:
                            "nearest it, shown in the table",
            "image size (default: the reference's, and a --size that differs from it is refused)")
     p.add_argument("--samplers", default=",".join(catalogue.DEFAULT_SAMPLERS),
-                   help=f"comma-separated sampler names (default: bose and every comparison sampler, "
+                   help=f"comma-separated sampler names, or all (default: bose and every comparison sampler, "
                         f"{','.join(catalogue.DEFAULT_SAMPLERS)})")
     p.add_argument("--reference", required=True, help="reference EXR (pyoa reference SCENE); its size is the "
                                                       "render's unless --size is given")
