@@ -27,7 +27,7 @@ from . import OFFSETS, backends, sampler, samplers, valid_spp
 from .atomic import atomic_path, check_writable
 from .backends import BackendUnavailable, PyoaFallbackWarning
 from .catalogue import get
-from .catalogue_types import MAX_UINT32, SppChoice, check_int
+from .catalogue_types import MAX_DIMS, MAX_UINT32, SppChoice, check_int
 from .cluster import TasksLost
 from .plots import FIGURE_WIDTH
 from .plots import MAX_SIZE as MAX_FIGURE_WIDTH
@@ -239,7 +239,7 @@ def cmd_spp(args) -> int:
     # named as options here (valid_spp names its keywords: near, dims, strength)
     for name in ("near", "dims", "strength"):
         if getattr(args, name) is not None:
-            _option(args, name, 0 if name == "near" else 1)
+            _option(args, name, 0 if name == "near" else 1, MAX_DIMS if name == "dims" else None)
     # valid_spp refuses --near, --dims and --strength values the sampler cannot have
     choices = valid_spp(args.sampler, near=args.near, dims=args.dims, strength=args.strength)
     shown = choices[: args.limit]

@@ -82,12 +82,12 @@ def test_points_counts_refused(good, args, words):
 SPP_COUNTS = [
     (["bush", "--strength", "99"], ["bush strength must be an integer in [2, 8]", "99"]),
     (["bose", "--strength", "3"], ["bose has strength 2 only (got strength=3)"]),
-    (["cmjnd", "--dims", "-4"], ["dims must be in [1, 1048576], got -4"]),
+    (["cmjnd", "--dims", "-4"], ["--dims must be in [1, 1048576], got -4"]),
     (["cmjnd", "--strength", "0"], ["strength must be >= 1"]),  # once listed s**0 = 1 forever
     (["bush", "--strength", "0"], ["strength must be >= 1"]),
     (["bose", "--limit", "-1"], ["--limit must be >= 1, got -1"]),
     (["bose", "--limit", "0"], ["--limit"]),
-    (["bose", "--near", "-5"], ["near must be >= 0, got -5"]),
+    (["bose", "--near", "-5"], ["--near must be >= 0, got -5"]),
     (["random", "--strength", "2"], ["random has no strength parameter"]),
 ]
 
@@ -98,8 +98,8 @@ def test_spp_refuses_what_the_api_refuses(args, words):
 
 
 FIGURE_COUNTS = [
-    ("plot", ["--figure-width", "10"], ["figure size must be an integer in [64, 8192]"]),
-    ("plot", ["--figure-width", "-900"], ["figure size"]),
+    ("plot", ["--figure-width", "10"], ["--figure-width must be in [64, 8192] (pixels), got 10"]),
+    ("plot", ["--figure-width", "-900"], ["--figure-width"]),
     ("plot", ["--pixel", "-1"], ["pixel must be in [0, 4294967295]"]),
     ("plot", ["--dims", "1"], ["2 <= dims <= 16"]),
     ("plot", ["--spp", "0"], ["spp"]),
@@ -107,7 +107,7 @@ FIGURE_COUNTS = [
     ("spectrum", ["--trials", "0"], ["trials must be in [1, 100000], got 0"]),
     ("spectrum", ["--trials", "-64"], ["trials"]),
     ("spectrum", ["--freq", "0"], ["freq must be in [4, 512], got 0"]),
-    ("spectrum", ["--figure-width", "0"], ["figure size"]),
+    ("spectrum", ["--figure-width", "0"], ["--figure-width"]),
     ("spectrum", ["--pair", "0,-1"], ["dims must be >= 0"]),
     ("spectrum", ["--pair", "1,1"], ["two different dimensions"]),
 ]
