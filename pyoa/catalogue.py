@@ -58,6 +58,16 @@ def shown(name: str) -> str:
     return canonical if name.lower() == canonical else f"{canonical} ({name})"
 
 
+def labels(typed) -> dict[str, str]:
+    """The samplers named in ``typed``, each once (its first spelling wins), as ``{catalogue name: what a
+    table shows}`` (:func:`shown`): the names a command's files store, with its tables' labels. An
+    unknown name fails, listing the valid ones."""
+    out: dict[str, str] = {}
+    for name in typed:
+        out.setdefault(get(name).name, shown(name))
+    return out
+
+
 def get(name: str) -> Construction:
     """Look up a construction by name (or a pbrt/Mitsuba name in :data:`ALIASES`), with an error that
     lists the valid ones."""

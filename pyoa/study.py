@@ -112,9 +112,7 @@ def sampler_names(text: str) -> list[str]:
     """``--samplers`` as distinct catalogue names, in the catalogue's spelling
     (``all``: every sampler). Rows, settings and the report compare these
     names, so ``--samplers BOSE`` continues a study of ``bose``."""
-    if str(text).strip().lower() == "all":
-        return catalogue.names()
-    return list(dict.fromkeys(canonical_sampler(n) for n in parse_list(text, "--samplers")))
+    return list(sampler_labels(text))
 
 
 def sampler_labels(text: str) -> dict[str, str]:
@@ -122,10 +120,7 @@ def sampler_labels(text: str) -> dict[str, str]:
     typed, beside the catalogue's when it is an alias (:func:`pyoa.catalogue.shown`)."""
     if str(text).strip().lower() == "all":
         return {n: n for n in catalogue.names()}
-    labels: dict[str, str] = {}
-    for n in parse_list(text, "--samplers"):
-        labels.setdefault(canonical_sampler(n), catalogue.shown(n))
-    return labels
+    return catalogue.labels(parse_list(text, "--samplers"))
 
 
 def reference_files(given: list[str] | None, scenes: list[str]) -> list[str] | None:

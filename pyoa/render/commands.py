@@ -215,11 +215,9 @@ def cmd_compare(args) -> int:
     if not typed:
         raise ValueError(f"--samplers {args.samplers!r} names no sampler; give a comma-separated list such as "
                          "bose,sobol (see pyoa samplers)")
-    # each sampler once, as typed (unknown names fail here, before any rendering): the tables show the
-    # catalogue's name with an alias beside it, the CSV the catalogue's name (catalogue.shown)
-    labels = {}
-    for n in typed:
-        labels.setdefault(catalogue.get(n).name, catalogue.shown(n))
+    # each sampler once (unknown names fail here, before any rendering): the tables show the catalogue's
+    # name with an alias beside it, the CSV the catalogue's name
+    labels = catalogue.labels(typed)
     names = list(labels)
     _check_counts(args)
     seeds = check_seeds(args.seed, args.seeds)
