@@ -243,6 +243,12 @@ def _make_class(base: type) -> type:
             self._passes = 0  # m_pass on the host, to refuse samples past sample_count
             self._pixel_seed = None
             self._lane_sample = None
+            self._forget_block()
+
+        def _forget_block(self) -> None:
+            """No block located yet in this pass (see :meth:`_located`): the next draw locates its own."""
+            self._block = dr.opaque(mi.UInt32, _NO_BLOCK)
+            self._block_seed = self._block_row = mi.UInt32(0)
 
         def seed(self, seed, wavefront_size=MAX_UINT32) -> None:
             # Mitsuba's lanes are pixels of `per_pass` samples (the count its render loop set just before
@@ -268,6 +274,7 @@ def _make_class(base: type) -> type:
             self.m_dimension = dr.opaque(mi.UInt32, 0)
             self.m_pass = dr.opaque(mi.UInt32, 0)
             self._passes = 0
+            self._forget_block()
 
         def _check_wavefront(self, n: int, per_pass: int) -> None:
             """Refuse a wavefront of ``n`` lanes that Mitsuba splits into pixels of ``per_pass`` samples
@@ -288,9 +295,10 @@ def _make_class(base: type) -> type:
             self.m_dimension = dr.opaque(mi.UInt32, 0)
             self.m_pass = self.m_pass + 1
             self._passes += 1
+            self._forget_block()  # a new pass: new sample indices, so new rows
 
         def schedule_state(self) -> None:
-            dr.schedule(self.m_dimension, self.m_pass)
+            dr.schedule(self.m_dimension, self.m_pass, self._block, self._block_seed, self._block_row)
 
         def clone(self):
             other = type(self)(dict(self._opts, sample_count=self._spp))
@@ -298,6 +306,8 @@ def _make_class(base: type) -> type:
             other._pixel_seed, other._lane_sample = self._pixel_seed, self._lane_sample
             other.m_dimension, other.m_pass = mi.UInt32(self.m_dimension), mi.UInt32(self.m_pass)
             other._passes = self._passes
+            other._block, other._block_seed, other._block_row = (mi.UInt32(x) for x in (
+                self._block, self._block_seed, self._block_row))
             return other
 
         def fork(self):
@@ -316,11 +326,33 @@ def _make_class(base: type) -> type:
             smp = self._pyoa
             entry = smp._construction
             i = self.m_pass * self._spw + self._lane_sample
+            j = mi.UInt32(self.m_dimension)
             f = _drjit.implementation(entry.name)
-            x = f(i, mi.UInt32(self.m_dimension), *entry.shape_args(smp.params), self._pixel_seed,
-                  *entry.options(smp.offset, smp.jitter))
+            args = (i, j, *entry.shape_args(smp.params), self._pixel_seed, *entry.options(smp.offset, smp.jitter))
+            x = f(*args, located=self._located(i, j)) if entry.family == "oa" else f(*args)
             self.m_dimension += 1
             return mi.Float(x)
+
+        def _located(self, i, j) -> tuple:
+            """``(P, row)`` of dimension ``j``'s block for every lane (docs/spec.md section 6), kept in
+            the sampler's state: a draw that enters a new block computes them, the block's other draws
+            reuse them, so a value costs its cell and tail only, not the block's hashes and two row
+            permutations. The dimension is the same in every lane (Mitsuba draws it for the whole
+            wavefront), so the loop below runs for all lanes or none: inside Mitsuba's symbolic loops
+            Dr.Jit skips its body on every draw that stays in the block."""
+            prm = self._pyoa.params
+            N, block = prm.s * prm.M, j // prm.block_dims
+            p = self._pixel_seed
+
+            def locate(P, row, todo):
+                P, row = _drjit.hashes.locate_block(p, i, block, N)
+                return P, row, todo & False
+
+            todo = dr.full(mi.Bool, True, dr.width(i)) & (block != self._block)
+            P, row, _ = dr.while_loop(state=(self._block_seed, self._block_row, todo),
+                                      cond=lambda P, row, todo: todo, body=locate, label="pyoa_locate_block")
+            self._block_seed, self._block_row, self._block = P, row, block
+            return P, row
 
         def next_2d(self, active=True):
             x = self.next_1d(active)
@@ -369,6 +401,10 @@ def sampler_class() -> type:
         cls = _CLASSES[variant] = _make_class(mi.Sampler)
     return cls
 
+
+#: The block number of "no block located yet" (:meth:`PyoaSampler._located`): no dimension's block is
+#: this large (block = dimension // B, and dimensions are counted in a uint32).
+_NO_BLOCK = 0xFFFFFFFF
 
 _CLASSES: dict[str, type] = {}
 _REGISTERED = False

@@ -87,6 +87,19 @@ def test_jitter_amounts_and_every_value_of_a_small_array():
                          numpy_values(smp, PIXELS, range(49), range(20)), f"jitter {jitter}")
 
 
+@pytest.mark.parametrize("s", [2, 3, 5, 7, 11, 13])
+def test_bose_cells_of_a_prime_s_on_every_row_and_column(s):
+    """Over a prime s the Dr.Jit cell takes one remainder per entry (pyoa._drjit.oa.bose_cell);
+    every (row, column), the last column included, against NumPy's cells."""
+    from pyoa._numpy import oa as numpy_oa
+
+    rows, cols = np.meshgrid(np.arange(s * s, dtype=np.uint32), np.arange(s + 1, dtype=np.uint32), indexing="ij")
+    got = _drjit.oa.bose_cell(UInt32(rows.ravel()), UInt32(cols.ravel()), s)
+    want = numpy_oa.bose_cell(rows.ravel(), cols.ravel(), s)
+    for g, w in zip(got, want):
+        assert (np.asarray(g) == w).all()
+
+
 @st.composite
 def random_sampler(draw):
     name = draw(st.sampled_from(_drjit.SUPPORTED))

@@ -142,6 +142,51 @@ def test_clone_and_fork_keep_the_parameters():
     assert "bush" in repr(smp) and "sample_count=27" in repr(smp)
 
 
+def test_a_clone_taken_inside_a_later_block_continues_its_values():
+    """The block's seed and rows are sampler state (kept per lane): a clone made mid-block draws
+    what the original draws, and both what pyoa generates."""
+    smp = load("bush", 27, strength=3)  # 4 columns per block
+    smp.set_samples_per_wavefront(27)
+    smp.seed(2, 54)
+    head = draws(smp, 6)  # into block 1
+    twin = smp.clone()
+    tail, twin_tail = draws(smp, 7), draws(twin, 7)  # through blocks 1-3
+    want = expected("bush", 27, {"strength": 3}, 2, 13, 2).reshape(54, 13)
+    assert (twin_tail.view(np.uint32) == tail.view(np.uint32)).all()
+    assert (np.concatenate([head, tail], -1).view(np.uint32) == want.view(np.uint32)).all()
+
+
+def test_a_block_is_located_once_not_once_per_value(monkeypatch):
+    """Issue 49: a draw that stays in its block reuses the block's seed and rows; only a draw
+    that enters a new block (or the first of a pass) computes them."""
+    calls = []
+    locate_block = pm._drjit.hashes.locate_block
+
+    def counted(*args):
+        calls.append(1)
+        return locate_block(*args)
+
+    monkeypatch.setattr(pm._drjit.hashes, "locate_block", counted)
+    smp = load("bose", 49, samples_per_pass=7)  # 8 columns per block; passes of 7 samples
+    smp.set_samples_per_wavefront(7)
+    smp.seed(4, 2 * 7)
+    want = expected("bose", 49, {}, 2, 24, 4)
+    # evaluated loops run a loop's body only while a lane is active (a symbolic loop traces it
+    # every time and skips it when the kernel runs), so the calls count the blocks located
+    with dr.scoped_set_flag(dr.JitFlag.SymbolicLoops, False):
+        got = np.stack([np.asarray(smp.next_1d()) for _ in range(24)], -1)  # blocks 0, 1 and 2
+        assert len(calls) == 3
+        smp.advance()  # a new pass reads other sample indices: its rows are located again,
+        again = np.asarray(smp.next_1d())
+        assert len(calls) == 4
+        smp.advance()  # even when the pass before ended in the same block (0)
+        third = np.asarray(smp.next_1d())
+        assert len(calls) == 5
+    assert (got.view(np.uint32) == want[:, :7].reshape(14, 24).view(np.uint32)).all()
+    assert (again.view(np.uint32) == want[:, 7:14, 0].ravel().view(np.uint32)).all()
+    assert (third.view(np.uint32) == want[:, 14:21, 0].ravel().view(np.uint32)).all()
+
+
 @pytest.mark.parametrize("props,error,match", [
     ({"sampler": "bose", "sample_count": 120}, ValueError, r"bose: .*nearest: 81 \(s=9\), 121 \(s=11\)"),
     ({"sampler": "sobol", "sample_count": 128}, ValueError, "no Dr.Jit implementation.*supported: bose"),

@@ -66,9 +66,17 @@ def locate(p, i, j, B: int, N: int):
     :mod:`.floats`; the tests compare against NumPy bit for bit)."""
     U = next((type(x) for x in (i, j, p) if dr.is_array_v(x)), None)
     i, j = U(i), U(j)
-    block, col = j // B, j % B
+    P, row = locate_block(p, i, j // B, N)
+    return P, row, j % B
+
+
+def locate_block(p, i, block, N: int):
+    """``(P, row)`` of sample ``i`` in block ``block`` (:func:`locate` without
+    the column): the block's array seed and the row it reads. A caller that
+    draws a block's dimensions one by one keeps these per lane and calls this
+    once per block (:mod:`pyoa.mitsuba`)."""
     P = block_seed(p, block)
-    return P, block_row(i, N, block_order_seed(P, block, N)), col
+    return P, block_row(i, N, block_order_seed(P, block, N))
 
 
 def block_row(i, N: int, r):
@@ -127,17 +135,45 @@ def permute(i, l: int, p):
     kernel), left out when ``l`` is a power of two (one round always lands
     below ``l`` then).
     """
-    U = type(i) if dr.is_array_v(i) else type(p)
-    i, p = U(i), U(p)
-    if l == 1:
-        return U(0)
-    w = walk_mask(l)
-    x = _permute_round(i, p, w)
-    if w + 1 != l:
-        x = dr.while_loop(state=(x, p), cond=lambda x, p: x >= l,
-                          body=lambda x, p: (_permute_round(x, p, w), p), label="pyoa_permute")[0]
-    L = U(l)
-    return dr.select(p == 0, i, (x + p % L) % L)
+    return permutes((i, l, p))[0]
+
+
+def permutes(*walks):
+    """Several :func:`permute` at once: ``permutes((i1, l1, p1), (i2, l2, p2))``
+    is ``[permute(i1, l1, p1), permute(i2, l2, p2)]``, bit for bit.
+
+    Their cycle walks run in one ``dr.while_loop``, each lane of each walk
+    stepping until it lands below its ``l``. A round is a chain of dependent
+    multiplications, and Dr.Jit's LLVM backend runs a kernel one packet of
+    lanes at a time, so a walk's loop is bound by that chain's latency and
+    repeats until the packet's slowest lane is done; walks in one loop
+    overlap their chains and share the wait for the slowest lane. With an OA
+    value's two walks (stratum and sub-stratum) in one loop, Bose ``cmj``
+    s = 11 ran at 260 against 230 M values/s with two loops (7.9 M values a
+    call, median of 15 alternating calls, Intel Xeon 6/207, 2 threads).
+    """
+    U = next((type(x) for w in walks for x in (w[0], w[2]) if dr.is_array_v(x)), None)
+    ins = [(U(i), l, U(p), walk_mask(l)) for i, l, p in walks]
+    xs = [U(0) if l == 1 else _permute_round(i, p, w) for i, l, p, w in ins]
+    loop = [k for k, (_, l, _, w) in enumerate(ins) if l > 1 and w + 1 != l]  # power-of-two l: one round lands
+    if loop:
+        def cond(*xw):
+            out = xw[0] >= ins[loop[0]][1]
+            for x, k in zip(xw[1:], loop[1:]):
+                out |= x >= ins[k][1]
+            return out
+
+        def body(*xw):
+            return tuple(dr.select(x >= ins[k][1], _permute_round(x, ins[k][2], ins[k][3]), x) for x, k in zip(xw, loop))
+
+        walked = dr.while_loop(state=tuple(xs[k] for k in loop), cond=cond, body=body, label="pyoa_permute")
+        for x, k in zip(walked, loop):
+            xs[k] = x
+    out = []
+    for x, (i, l, p, _) in zip(xs, ins):
+        L = U(l)
+        out.append(U(0) if l == 1 else dr.select(p == 0, i, (x + p % L) % L))
+    return out
 
 
 def randfloat(i, p):

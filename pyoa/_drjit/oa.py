@@ -24,7 +24,7 @@ from .. import gf
 from ..reference import oa as G  # the constructions' geometries (N, B, s, M)
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
 from .floats import centered_value, jitter_value, sample_value
-from .hashes import locate, permute, randfloat
+from .hashes import locate, permute, permutes, randfloat
 
 
 @cache
@@ -67,6 +67,18 @@ def bose_cell(i, col, s: int):
     F = field(U, s)
     a0, a1 = i // s, i % s
     k = dr.select(col % 2 == 1, col - 1, col + 1)
+    if not F.tabled:
+        # Prime s: each entry as one remainder, (c0 a0 + c1 a1) % s, with the column's coefficients
+        # (1, 0), (0, 1) or (1, col - 1): the same integers as the selects below, but one remainder
+        # per entry instead of two (the sums stay below s + s^2). Inside Mitsuba the column is the
+        # same in every lane, so the coefficients cost nothing per lane; the remainders do (a
+        # multiply-high each), and the cell was a third of a value's time there.
+        def entry(c):
+            c0 = dr.select(c == 1, U(0), U(1))
+            c1 = dr.select(c == 0, U(0), dr.select(c == 1, U(1), (c - 1) % s))
+            return (c0 * a0 + c1 * a1) % s
+
+        return entry(col), entry(k)
     # columns 0 and 1 use multiplier 0 only to keep table indices in range
     m_j = dr.select(col >= 2, col - 1, U(0)) % s
     m_k = dr.select(col >= 2, k - 1, U(0)) % s
@@ -98,27 +110,36 @@ def cmjnd_cell(i, col, s: int, t: int):
     return (i // sj) % s, i % sj + (i // (sj * s)) * sj
 
 
-def offset_sub(offset: str, u, M: int, cell_key, aij, P2):
-    """The integer sub-stratum of the hashed offset styles (``centered`` has none)."""
-    seed = {"j": cell_key * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset]
-    return permute(u, M, seed)
+def offset_seed(offset: str, cell_key, aij, P2):
+    """The seed of the sub-stratum permutation of the hashed offset styles (``centered`` has none)."""
+    return {"j": cell_key * P2, "mj": (aij + 1) * P2, "cmj": P2}[offset]
 
 
-def oa_value(i, j, p, offset: str, jitter: float, geometry, cell):
+def oa_value(i, j, p, offset: str, jitter: float, geometry, cell, located=None):
     """:func:`pyoa.reference.oa.oa_value` over Dr.Jit arrays: the frame every
     construction shares. The block rule (:func:`.hashes.locate`) gives the
     copy's seed, the row and the column; ``cell(row, col)`` gives
     ``(A_ij, u, cell_key)``; then stratum, offset and the jitter of the row
-    (docs/spec.md section 5.2)."""
+    (docs/spec.md section 5.2).
+
+    ``located``, when given, is ``(P, row)`` of dimension ``j``'s block as
+    :func:`.hashes.locate` gives them, kept by a caller that draws the
+    dimensions of a block one after another (the Mitsuba plugin keeps them
+    per lane, :mod:`pyoa.mitsuba`): they depend on (pixel, block, sample)
+    only, so the block's hashes and its two row permutations are then paid
+    once per block, not once per value. The bits are the same."""
     N, B, s, M = geometry
-    P, row, col = locate(p, i, j, B, N)
+    if located is None:
+        P, row, col = locate(p, i, j, B, N)
+    else:
+        (P, row), col = located, type(located[1])(j) % B
     aij, u, cell_key = cell(row, col)
     q = P * (col + 1)  # times the three keys: the column's seeds (section 3.3)
-    stratum = permute(aij, s, q * STRATUM_KEY)
     jit = jitter_value(randfloat(row, q * JITTER_KEY), jitter)
     if offset == "centered":
-        return centered_value(stratum, jit, M, s)
-    sub = offset_sub(offset, u, M, cell_key, aij, q * SUBSTRATUM_KEY)
+        return centered_value(permute(aij, s, q * STRATUM_KEY), jit, M, s)
+    # both permutations' walks in one loop (permutes says why)
+    stratum, sub = permutes((aij, s, q * STRATUM_KEY), (u, M, offset_seed(offset, cell_key, aij, q * SUBSTRATUM_KEY)))
     return sample_value(stratum, sub, jit, M, s)
 
 
@@ -127,23 +148,23 @@ def _row_key(cell, *shape):
     return lambda row, col: (*cell(row, col, *shape), row + 1)
 
 
-def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0):
+def bose(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0, located=None):
     """:func:`pyoa.reference.bose` over Dr.Jit arrays."""
     def cell(row, col):
         aij, aik = bose_cell(row, col, s)
         return aij, aik, aik * s + aij + 1  # the 'j' offset's key is the (A_ij, A_ik) cell
 
-    return oa_value(i, j, p, offset, jitter, G.bose_geometry(s), cell)
+    return oa_value(i, j, p, offset, jitter, G.bose_geometry(s), cell, located)
 
 
-def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0):
+def cmjnd(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0, located=None):
     """:func:`pyoa.reference.cmjnd` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, G.cmjnd_geometry(s, t), _row_key(cmjnd_cell, s, t))
+    return oa_value(i, j, p, offset, jitter, G.cmjnd_geometry(s, t), _row_key(cmjnd_cell, s, t), located)
 
 
-def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0):
+def bush(i, j, s: int, t: int, p, offset: str = "cmj", jitter: float = 1.0, located=None):
     """:func:`pyoa.reference.bush` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, G.bush_geometry(s, t), _row_key(bush_cell, s, t))
+    return oa_value(i, j, p, offset, jitter, G.bush_geometry(s, t), _row_key(bush_cell, s, t), located)
 
 
 def addelman_kempthorne_cell(i, col, q: int):
@@ -178,11 +199,11 @@ def bose_bush_cell(i, col, s: int):
     return dr.select(last, x % s, a), dr.select(last, (x // s) * s + k, x)
 
 
-def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0):
+def addelman_kempthorne(i, j, q: int, p, offset: str = "cmj", jitter: float = 1.0, located=None):
     """:func:`pyoa.reference.addelman_kempthorne` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, G.addelman_kempthorne_geometry(q), _row_key(addelman_kempthorne_cell, q))
+    return oa_value(i, j, p, offset, jitter, G.addelman_kempthorne_geometry(q), _row_key(addelman_kempthorne_cell, q), located)
 
 
-def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0):
+def bose_bush(i, j, s: int, p, offset: str = "cmj", jitter: float = 1.0, located=None):
     """:func:`pyoa.reference.bose_bush` over Dr.Jit arrays."""
-    return oa_value(i, j, p, offset, jitter, G.bose_bush_geometry(s), _row_key(bose_bush_cell, s))
+    return oa_value(i, j, p, offset, jitter, G.bose_bush_geometry(s), _row_key(bose_bush_cell, s), located)
