@@ -24,7 +24,8 @@ result array: the rate at which the machine writes float32 values at all.
 The ``of fill`` column divides every rate (pyoa's and the peers') by the fill
 rate of the same case in the same run; the generation goals are stated as
 such fractions (docs/performance.md), because the machine's speed drifts
-between processes and differs between CPUs.
+between processes and differs between CPUs. The ``of compute`` column
+divides the opencl rate by the cores' bound instead (Compute ceiling, below).
 
 Reported per case and backend: the value count ``P * spp * dims``, the median,
 minimum and maximum of the timed runs, and the throughput
@@ -70,6 +71,30 @@ rejects the configuration) or ``failed`` (the subprocess's exit status and
 first line of stderr), never silently left out. Peers never change the exit
 status.
 
+Compute ceiling
+---------------
+The write rate differs 5x between CPUs, so "of fill" alone does not say
+whether the kernels are bound by memory or by the cores' arithmetic. For
+the required case and the blocks' cases (``CEILING_CASES``), when the
+``opencl`` rows ran on a PoCL CPU device, the report states the other bound
+beside it: ``compute_ceiling.ceiling`` (``compute_ceiling.py``, whose
+docstring gives the method) builds the case's vector-path kernels in a
+subprocess with a fresh ``POCL_CACHE_DIR``, finds PoCL's work-item loop in
+the machine code of ``vector_values`` (one iteration: 8 sample positions x
+dims values of one pixel), counts its instructions, has ``llvm-mca-15``
+(host CPU model) give the cycles one iteration needs, and states
+``cores x clock x values per iteration / cycles per iteration``, with the
+clock the VM reports (``/proc/cpuinfo``, nominal, not measured). It runs
+after every timed call (it compiles kernels, a few seconds per case, and
+must not disturb the timing). The ``opencl`` row of those cases gets the
+ceiling in M values/s and its median rate's fraction of it ("of compute"),
+and a note says which bound the rate is closer to. A ceiling that cannot be
+taken (no ``llvm-mca-15`` or disassembler, not a CPU device, a forced
+non-vector ``PYOA_OPENCL_PATH``, any error) reads "not measured", with the
+reason in the notes and the JSON, and never changes the exit status;
+``--no-ceiling`` skips it. The ceiling counts the values kernel alone (not
+the tables kernel, the launches or memory stalls), at the nominal clock.
+
 Noise
 -----
 On the 2-core PoCL machines this project is measured on, the same workload
@@ -83,9 +108,12 @@ metadata) show whether other work competed for the two cores.
 Output
 ------
 ``benchmarks/results/generate.json`` (``--out`` to change) with every run's
-time and the machine's description, and a Markdown table beside it with the
-same stem (``generate.md``); both are written atomically. The table is also
-printed at the end.
+time and the machine's description (and, from schema 3,
+``compute_ceilings``: ``compute_ceiling.ceiling``'s dictionary per case,
+with ``compute_ceiling_values_per_s`` and ``of_compute_ceiling`` on the
+opencl rows), and a Markdown table beside it with the same stem
+(``generate.md``); both are written atomically. The table is also printed
+at the end.
 
 Usage::
 
@@ -95,6 +123,7 @@ Usage::
     python benchmarks/bench_generate.py --cases default,baselines  # Bose and the comparison samplers
     python benchmarks/bench_generate.py --backends opencl --repeats 9
     python benchmarks/bench_generate.py --no-peers      # pyoa rows only
+    python benchmarks/bench_generate.py --no-ceiling    # without the compute ceiling (llvm-mca)
 """
 
 from __future__ import annotations
@@ -102,6 +131,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import os
 import statistics
 import sys
 import time
@@ -124,7 +154,7 @@ from common import loadavg, log, machine, machine_lines, write_text  # noqa: E40
 DEFAULT_OUT = REPO / "benchmarks" / "results" / "generate.json"
 FULL_PIXELS = 65536
 QUICK_PIXELS = 4096
-SCHEMA = 2  # 2: the "peers" list
+SCHEMA = 3  # 2: the "peers" list; 3: "compute_ceilings" and the opencl rows' compute_ceiling_values_per_s
 PEER_BUDGET_S = 3.0
 QUICK_PEER_BUDGET_S = 0.5
 
@@ -170,6 +200,8 @@ CASES.update({
 #: The comparison and progressive samplers' cases (``--cases baselines``).
 BASELINE_CASES = tuple(c for c, spec in CASES.items() if spec["offset"] is None)
 REQUIRED_CASE = "bose-cmj-121x10"
+#: The cases whose opencl row gets a compute ceiling (compute_ceiling.py): the required one and the blocks'.
+CEILING_CASES = BLOCK_CASES
 #: The full set of cases takes about 8 minutes on a 2-core machine (NumPy
 #: dominates), over the 5-minute budget for a default run, so only the
 #: required case runs by default; ``--cases all`` runs every case.
@@ -324,6 +356,60 @@ def bench(cases: list[str], backends: list[str], pixels: int, repeats: int, seed
 
 
 # ---------------------------------------------------------------------------
+# compute ceiling
+
+
+def _no_ceiling(reason: str) -> dict:
+    return {"status": "not measured", "reason": reason}
+
+
+def compute_ceilings(cases: list[str], results: list[dict], seed: int) -> dict[str, dict]:
+    """``compute_ceiling.ceiling`` of every case in CEILING_CASES whose opencl row ran on a PoCL CPU
+    device, keyed by case; a case it cannot measure gets status "not measured" and the reason. Sets
+    ``compute_ceiling_values_per_s`` and ``of_compute_ceiling`` on those opencl rows. Never raises."""
+    wanted = [c for c in cases if c in CEILING_CASES]
+    rows = {r["case"]: r for r in results if r["backend"] == "opencl"}
+    wanted = [c for c in wanted if c in rows]
+    if not wanted:
+        return {}
+    try:
+        import compute_ceiling  # benchmarks/ is on sys.path (see the imports above)
+    except Exception as exc:  # noqa: BLE001 - a missing or broken helper is reported, not fatal
+        return {c: _no_ceiling(f"cannot import compute_ceiling.py ({type(exc).__name__}: {exc})") for c in wanted}
+    path = os.environ.get("PYOA_OPENCL_PATH") or "auto"
+    out: dict[str, dict] = {}
+    for case in wanted:
+        row, spec = rows[case], CASES[case]
+        device = row.get("device") or ""
+        if row["status"] != "ok" or "median_values_per_s" not in row:
+            res = _no_ceiling(f"the opencl row did not run ({row['status']})")
+        elif "(cpu)" not in device or "Portable Computing Language" not in device:
+            res = _no_ceiling(f"not a PoCL CPU device ({device})")
+        elif path not in ("auto", "vector"):
+            res = _no_ceiling(f"PYOA_OPENCL_PATH={path}: the opencl row did not take the vector path")
+        else:
+            t0 = time.perf_counter()
+            try:
+                res = compute_ceiling.ceiling(spec["name"], spec["spp"], spec["dims"], spec["offset"],
+                                              strength=spec["strength"], seed=seed)
+            except Exception as exc:  # noqa: BLE001 - ceiling() should not raise; never fail the benchmark
+                res = _no_ceiling(f"{type(exc).__name__}: {exc}")
+            res["elapsed_s"] = time.perf_counter() - t0
+        if res["status"] == "ok":
+            cap = res["ceiling_values_per_s"]
+            row["compute_ceiling_values_per_s"] = cap
+            row["of_compute_ceiling"] = row["median_values_per_s"] / cap
+            log(f"  {case:<22} opencl  compute ceiling {cap / 1e6:9.1f} M values/s "
+                f"({res['cycles_per_iteration']:.1f} cycles / {res['values_per_iteration']} values, "
+                f"-mcpu={res['mca']['mcpu']}); measured {row['of_compute_ceiling']:.2f} of it")
+        else:
+            row["compute_ceiling"] = f"not measured: {res['reason']}"
+            log(f"  {case:<22} opencl  compute ceiling not measured: {res['reason']}")
+        out[case] = res
+    return out
+
+
+# ---------------------------------------------------------------------------
 # report
 
 
@@ -397,6 +483,33 @@ def peers_markdown(report: dict) -> list[str]:
     return lines
 
 
+def ceiling_notes(report: dict, rate: dict) -> list[str]:
+    """One note per compute ceiling: which bound, fill (memory) or compute, the opencl rate is closer to."""
+    notes = []
+    for case, c in (report.get("compute_ceilings") or {}).items():
+        if c["status"] != "ok":
+            notes.append(f"- {case} / opencl: compute ceiling not measured: {c['reason']}")
+            continue
+        got, fill, cap = rate.get((case, "opencl")), rate.get((case, "fill")), c["ceiling_values_per_s"]
+        how = (f"{c['cores']} cores x {c['clock_mhz']:,.0f} MHz (nominal, as the VM reports it) x "
+               f"{c['values_per_iteration']} values / {c['cycles_per_iteration']:,.1f} cycles per work-item "
+               f"(llvm-mca -mcpu={c['mca']['mcpu']}; {c['counts']['instructions']:,} instructions, "
+               f"{c['instructions_per_value']:.2f} per value; compute_ceiling.py)")
+        if not got:
+            notes.append(f"- {case} / opencl: compute ceiling {_m(cap)} M values/s = {how}")
+        elif fill:
+            closer = "compute (the cores' arithmetic)" if got / cap > got / fill else "memory (fill)"
+            far = f", though far from both (at most {max(got / cap, got / fill):.2f} of either)" if max(
+                got / cap, got / fill) < 0.5 else ""
+            notes.append(f"- {case} / opencl: {got / fill:.2f} of fill ({_m(fill)} M values/s) and {got / cap:.2f} "
+                         f"of the compute ceiling ({_m(cap)} M values/s = {how}): closer to the {closer} "
+                         f"bound{far}")
+        else:
+            notes.append(f"- {case} / opencl: {got / cap:.2f} of the compute ceiling ({_m(cap)} M values/s = "
+                         f"{how}); no fill row in this run to compare with")
+    return notes
+
+
 def markdown(report: dict) -> str:
     meta, cfg = report["machine"], report["config"]
     lines = ["# pyoa generate benchmark", ""]
@@ -413,23 +526,31 @@ def markdown(report: dict) -> str:
         "; M values/s = values / median seconds. Process-to-process noise "
         "on this machine kind is 15-25 %: compare rows of this table, not separate runs.",
         "",
-        "| case | backend | values | median s | M values/s | min s | max s | spread | vs numpy | of fill |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    show_cap = bool(report.get("compute_ceilings"))  # the two columns only when some row has a ceiling
+    lines += [
+        "| case | backend | values | median s | M values/s | min s | max s | spread | vs numpy | of fill |"
+        + (" compute ceiling M values/s | of compute |" if show_cap else ""),
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|" if show_cap else ""),
     ]
     numpy_rate = {r["case"]: r.get("median_values_per_s") for r in report["results"] if r["backend"] == "numpy"}
     fill_rate = {r["case"]: r.get("median_values_per_s") for r in report["results"] if r["backend"] == "fill"}
     for r in report["results"]:
         if "median_s" not in r:
-            lines.append(f"| {r['case']} | {r['backend']} | {r['values']:,} | {r['status']} | | | | | | |")
+            lines.append(f"| {r['case']} | {r['backend']} | {r['values']:,} | {r['status']} | | | | | | |"
+                         + (" | |" if show_cap else ""))
             continue
         base = numpy_rate.get(r["case"])
         ratio = f"{r['median_values_per_s'] / base:.1f}x" if base and r["backend"] not in ("numpy", "fill") else ""
         fill = fill_rate.get(r["case"])
         of_fill = f"{r['median_values_per_s'] / fill:.3f}" if fill and r["backend"] != "fill" else ""
+        cap = r.get("compute_ceiling_values_per_s")
+        cap_text = _m(cap) if cap else "not measured" if r.get("compute_ceiling") else ""  # why: in the notes
+        of_cap = f"{r['of_compute_ceiling']:.3f}" if cap else ""
         lines.append(
             f"| {r['case']} | {r['backend']} | {r['values']:,} | {r['median_s']:.3f} | "
             f"{_m(r['median_values_per_s'])} | {r['min_s']:.3f} | {r['max_s']:.3f} | "
-            f"{100 * r['spread']:.0f} % | {ratio} | {of_fill} |"
+            f"{100 * r['spread']:.0f} % | {ratio} | {of_fill} |" + (f" {cap_text} | {of_cap} |" if show_cap else "")
         )
     notes = [f"- {r['case']} / {r['backend']}: {r['status']}: {r['reason']}"
              for r in report["results"] if r["status"] != "ok"]
@@ -441,6 +562,7 @@ def markdown(report: dict) -> str:
                          "(one block), in this run")
     for case, same in report["bits_match"].items():
         notes.append(f"- {case}: backends gave {'identical' if same else 'DIFFERENT'} bits (BLAKE2b of the output)")
+    notes += ceiling_notes(report, rate)
     if notes:
         lines += ["", *notes]
     lines += peers_markdown(report)
@@ -524,6 +646,9 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--opencl-devices", choices=("default", "all"), default="default",
                     help="'all': time the opencl rows on every OpenCL device that builds pyoa's kernels, in this "
                          "run (rows opencl[P:D] beside pyoa's default device's opencl row); default: default")
+    ap.add_argument("--no-ceiling", dest="ceiling", action="store_false",
+                    help="do not compute the opencl rows' compute ceiling (compute_ceiling.py: llvm-mca on PoCL's "
+                         "machine code; only for the required and the blocks' cases)")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
     args = ap.parse_args(argv)
     if args.repeats < 1:
@@ -574,6 +699,8 @@ def main(argv=None) -> int:
                                        budget_s=args.peer_budget, repeats=args.repeats, seed=args.seed,
                                        full_pixels=FULL_PIXELS, log=log)
     meta["loadavg_start"], meta["loadavg_end"] = load_start, loadavg()
+    # after the timing and the load average: it compiles kernels in a subprocess (a few seconds per case)
+    ceilings = compute_ceilings(args.cases, results, args.seed) if args.ceiling else {}
     bits_match = {}
     for case in args.cases:
         mine = [r for r in results if r["case"] == case and r.get("digest") and r["backend"] != "fill"]
@@ -593,11 +720,13 @@ def main(argv=None) -> int:
                    "full_workload": args.pixels == FULL_PIXELS,
                    "peers": run_peers, "peer_budget_s": args.peer_budget, "peer_pixels": args.peer_pixels,
                    "peers_note": None if run_peers else "--no-peers" if not args.peers else
-                   f"the required case {REQUIRED_CASE} is not among the cases"},
+                   f"the required case {REQUIRED_CASE} is not among the cases",
+                   "ceiling": args.ceiling},
         "machine": meta,
         "results": results,
         "bits_match": bits_match,
         "peers": peer_results,
+        "compute_ceilings": ceilings,
         "total_s": time.perf_counter() - t_start,
     }
     md = markdown(report)

@@ -9,7 +9,14 @@
  *   VNKP            VNK rounded up to whole blocks of 8
  *   VDMAX           dimensions per block (docs/spec.md section 6)
  *   VN, VWN         rows N = s M of the array and the walk mask of N
- *   VLATER          1: some dimension lies past block 0 (its own rows)
+ *   VLATER          1: some dimension lies past block 0 (its own rows); then also
+ *   VNSLOT          the distinct blocks of the request's dimensions (slots)
+ *   VLATER0         the first slot past block 0 (1 when block 0 is among them, else 0)
+ *   VSLOT_FIRST, VSLOT_OF, VCOL_OF   __constant tables: the first dimension d of
+ *                   each slot, and each d's slot and column (generated text)
+ *   VRW             words of a row's record (the cells of every column of a row, packed)
+ *   VCB, VCPW       bits of one packed cell and cells per record word
+ *   VAB, VAMASK, VUMASK   bits of A_ij in a cell, then the masks of A_ij and of u
  *   VGROUPED        1: more than 16 dimensions, computed and stored in groups of 8
  *   VOFFSET         the offset's code (OFFSET_* of pyoa.constructions)
  *   VS_PACKED       1: the stratum permutation is tabled as 4-bit fields
@@ -18,6 +25,7 @@
  *                   M <= 16), 2 walked per value (VSUB_ROUNDS rounds)
  *   VJKEY_BOSE      1: the 'j' seed factor is Bose's u * s + A_ij + 1, else i + 1
  *   VSTORE_BLOCK, VSTORE_TAIL   the stores of one block (generated code)
+ *   VSTORE_GROUPS   with VGROUPED, the values and stores of every whole group of 8 (generated code)
  *
  * Why this shape (each measured on PoCL, docs/performance.md): the values
  * kernel computes 8 sample positions of one pixel per work-item as explicit
@@ -58,25 +66,6 @@ static inline __attribute__((always_inline)) uint8 permute_bounded_v8(uint8 i, u
 }
 
 #ifndef VBASELINE  /* the orthogonal arrays' kernels */
-
-/* Kensler's permute of 8 lanes with one seed p != 0 (a later block's order
- * of the rows, docs/spec.md section 6): the cycle walk as a loop over the
- * whole vector, which runs once per (pixel, block, 8 samples), not per value. */
-static inline __attribute__((always_inline)) uint8 permute_walk_v8(uint8 i, uint p, uint l, uint w)
-{
-    uint8 P = (uint8)p;
-    uint8 x = permute_round_v8(i, P, w);
-    while (any(x >= l))
-        x = (x < l) ? x : permute_round_v8(x, P, w);
-    x += p % l;
-    return (x >= l) ? x - l : x;
-}
-
-/* block_row (hashes.cl) of 8 samples of one block, order seed r != 0. */
-static inline __attribute__((always_inline)) uint8 block_row_v8(uint8 i, uint r)
-{
-    return permute_walk_v8(permute_walk_v8(i, r, VN, VWN), mix32(r), VN, VWN);
-}
 
 /* Lanes r of t[idx.sr]: a gather of 8 table entries. */
 static inline __attribute__((always_inline)) uint8 gather_v8(__global const uint *t, uint8 idx)
@@ -158,31 +147,39 @@ __kernel void vector_tables(__global uint *restrict pk,
  * positions [8 b, 8 b + 8) of pixel pl: lanes r of the result. i holds the
  * sample indices. cell_a and cell_u are the cells of docs/spec.md section 5
  * at the sample indices, laid out [d][k] with rows of VNKP
- * (pyoa.host_tables.cells, padded): block 0's rows. A dimension of a later
- * block (VLATER: the request has one) reads its copy at its own rows
- * (docs/spec.md section 6): the row permutation is walked once per block and
- * 8 samples (*last_order, *later_row carry it from one dimension to the
- * next of the same block), and its cells are gathered from every row's
- * cells, array_a and array_u, laid out [d][row] (pyoa.host_tables.array_cells). */
+ * (pyoa.host_tables.cells, padded).
+ *
+ * A request with a dimension past block 0 (VLATER) reads each block's copy at
+ * that block's own rows (docs/spec.md section 6), which depend on (pixel,
+ * block, sample) only: vector_rows computes them beforehand, and
+ * vector_values loads them once per work-item and block (slot), before any
+ * value, with the records of those rows (rows, rec: see locate_slots). A
+ * dimension then takes its cell from its column's field of its block's
+ * record, two shifts and masks, and the code that computes values is the
+ * same straight line for every dimension. (Before, a later dimension walked
+ * its block's rows inside this kernel, once per block and 8 samples, and
+ * gathered its own two cells per value: 36 dimensions ran at 0.57-0.62x the
+ * values/s of 12, docs/performance.md.) */
 static inline __attribute__((always_inline)) float8 value_v8(
     uint d, uint b, uint pl, uint8 i, float J,
     __global const uint *restrict pk, __global const uint *restrict cell_a, __global const uint *restrict cell_u,
-    __global const uint *restrict array_a, __global const uint *restrict array_u,
-    uint *last_order, uint8 *later_row)
+    const uint8 *rows, const uint8 *rec)
 {
     __global const uint *w = pk + 8u * (pl * VND + d);
-    uint8 aij = vload8(b, cell_a + d * VNKP);
-    uint8 row = i;
 #if VLATER
-    uint order = w[5];
-    if ((VLATER_MASK >> d) & 1ul) {  /* a later block (known when the program is built): its own rows */
-        if (order != *last_order) {
-            *later_row = block_row_v8(i, order);
-            *last_order = order;
-        }
-        row = *later_row;
-        aij = gather_v8(array_a + d * VN, row);
-    }
+    uint slot = VSLOT_OF[d], col = VCOL_OF[d];
+    uint8 row = rows[slot];
+    uint8 field = rec[slot * VRW + col / VCPW] >> ((col % VCPW) * VCB);
+    uint8 aij = field & VAMASK;
+#if VSUB != 0
+    uint8 u = (field >> VAB) & VUMASK;
+#endif
+#else
+    uint8 row = i;
+    uint8 aij = vload8(b, cell_a + d * VNKP);
+#if VSUB != 0
+    uint8 u = vload8(b, cell_u + d * VNKP);
+#endif
 #endif
 #if VS_PACKED
     uint8 stratum = field4_v8((uint8)w[0], (uint8)w[1], aij);
@@ -193,10 +190,6 @@ static inline __attribute__((always_inline)) float8 value_v8(
 #if VSUB == 0
     return centered_value_v8(stratum, jit, VM, VS);
 #else
-    uint8 u = vload8(b, cell_u + d * VNKP);
-#if VLATER
-    if ((VLATER_MASK >> d) & 1ul) u = gather_v8(array_u + d * VN, row);
-#endif
 #if VSUB == 1
     uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
 #else
@@ -217,7 +210,93 @@ static inline __attribute__((always_inline)) float8 value_v8(
 #endif
 }
 
-#define VALUE_V8(d) value_v8((d), b, pl, i, J, pk, cell_a, cell_u, array_a, array_u, &last_order, &later_row)
+#if VLATER
+/* vector_rows without a table walks the rows of the VNKP sample positions in
+ * chunks of this many 8-lane vectors. */
+#define WALK_VECTORS 8u
+
+/* Kensler's permute on [0, VN) with seed p != 0 of WALK_VECTORS vectors x at
+ * once: one cycle walk for all of them (a loop until every lane of every
+ * vector is below VN), then the final shift. A walk is a chain of dependent
+ * multiplications repeated until its slowest lane lands; eight independent
+ * chains in one loop overlap and share that wait. */
+static inline __attribute__((always_inline)) void permute_walks(uint8 *x, uint p)
+{
+    uint8 P = (uint8)p;
+    #pragma unroll
+    for (uint c = 0u; c < WALK_VECTORS; ++c)
+        x[c] = permute_round_v8(x[c], P, VWN);
+    for (;;) {
+        int8 out = 0;
+        #pragma unroll
+        for (uint c = 0u; c < WALK_VECTORS; ++c)
+            out |= x[c] >= VN;
+        if (!any(out))
+            break;
+        #pragma unroll
+        for (uint c = 0u; c < WALK_VECTORS; ++c)
+            x[c] = (x[c] < VN) ? x[c] : permute_round_v8(x[c], P, VWN);
+    }
+    #pragma unroll
+    for (uint c = 0u; c < WALK_VECTORS; ++c) {
+        x[c] += p % VN;
+        x[c] = (x[c] >= VN) ? x[c] - VN : x[c];
+    }
+}
+
+/* The rows of a later block (docs/spec.md section 6: block_row, two
+ * permutations with the block's order seed) at every sample position of the
+ * request, per pixel: rowtab[((pl (VNSLOT - VLATER0) + k) VNKP + s] for later
+ * slot k (axis 0) and pixel pl (axis 1). They depend on (pixel, block,
+ * sample) only, so they are computed here once, not inside vector_values
+ * (there, a walk per block and 8 samples ran one chain of rounds at a time:
+ * about a fifth of a 36-dimension request's time, docs/performance.md).
+ * WALK_VECTORS vectors at a time (permute_walks). */
+__kernel void vector_rows(__global uint *restrict rowtab,
+                          __global const uint *restrict pk,
+                          __global const uint *restrict isamp)
+{
+    uint k = (uint)get_global_id(0), pl = (uint)get_global_id(1);
+    uint order = pk[8u * (pl * VND + VSLOT_FIRST[VLATER0 + k]) + 5u];  /* never 0 past block 0 */
+    __global uint *o = rowtab + (pl * (VNSLOT - VLATER0) + k) * VNKP;
+    for (uint c0 = 0u; c0 < VNKP / 8u; c0 += WALK_VECTORS) {
+        uint8 x[WALK_VECTORS];
+        #pragma unroll
+        for (uint c = 0u; c < WALK_VECTORS; ++c)  /* past the last vector: repeat it (not stored) */
+            x[c] = vload8(min(c0 + c, VNKP / 8u - 1u), isamp);
+        permute_walks(x, order);
+        permute_walks(x, mix32(order));
+        #pragma unroll
+        for (uint c = 0u; c < WALK_VECTORS; ++c)
+            if (c0 + c < VNKP / 8u)
+                vstore8(x[c], c0 + c, o);
+    }
+}
+
+/* The rows of samples i (8 lanes) in every block of the request (slot k:
+ * rows[k]; block 0's rows are i, later blocks' from vector_rows) and their
+ * records (rec[k VRW + word]: pyoa._opencl.vector.row_records, the cells of
+ * every column of a row, packed), for pixel pl. */
+static inline __attribute__((always_inline)) void locate_slots(
+    uint b, uint pl, uint8 i, __global const uint *restrict rowtab, __global const uint *restrict records,
+    uint8 *rows, uint8 *rec)
+{
+    #pragma unroll
+    for (uint k = 0u; k < VNSLOT; ++k) {
+        uint8 r = (k < VLATER0) ? i : vload8(b, rowtab + (pl * (VNSLOT - VLATER0) + k - VLATER0) * VNKP);
+        rows[k] = r;
+        #pragma unroll
+        for (uint q = 0u; q < VRW; ++q)
+            rec[k * VRW + q] = gather_v8(records + q, r * VRW);
+    }
+}
+#define SLOT_STATE uint8 slot_rows[VNSLOT], slot_rec[VNSLOT * VRW]; \
+    locate_slots(b, pl, i, rowtab, records, slot_rows, slot_rec)
+#else
+#define SLOT_STATE const uint8 *slot_rows = 0, *slot_rec = 0
+#endif
+
+#define VALUE_V8(d) value_v8((d), b, pl, i, J, pk, cell_a, cell_u, slot_rows, slot_rec)
 
 #if VGROUPED
 /* n (<= 8) dimensions from d0 of the 8 rows at o (row stride VND), `rows`
@@ -257,25 +336,18 @@ __kernel void vector_values(__global float *restrict out,
                             __global const uint *restrict cell_a,
                             __global const uint *restrict cell_u,
                             __global const uint *restrict isamp,
-                            __global const uint *restrict array_a,
-                            __global const uint *restrict array_u,
+                            __global const uint *restrict rowtab,
+                            __global const uint *restrict records,
                             const float J)
 {
     uint b = (uint)get_global_id(0), pl = (uint)get_global_id(1);
     uint8 i = vload8(b, isamp);
-    uint last_order = 0u;
-    uint8 later_row = i;
+    SLOT_STATE;
 #if VGROUPED
     __global float *o = out + out0 + (pl * VNK + 8u * b) * VND;
     uint rows = ((VNK % 8u) != 0u && b + 1u == VNKP / 8u) ? VNK % 8u : 8u;
     float8 V[8];
-    #pragma nounroll
-    for (uint g = 0u; g < VND / 8u; ++g) {
-        #pragma unroll
-        for (uint e = 0u; e < 8u; ++e)
-            V[e] = VALUE_V8(8u * g + e);
-        store_group(o + 8u * g, V, 8u, rows);
-    }
+    VSTORE_GROUPS  /* each whole group of 8: its 8 values, then store_group (generated, every d a constant) */
 #if VND % 8u
     #pragma unroll
     for (uint e = 0u; e < VND % 8u; ++e)

@@ -80,6 +80,8 @@ class OpenCLBackend:
         self._scratch_bufs: dict[str, object] = {}
         #: the last request shape's array cells (_array_cells) and its key
         self._cells_key, self._cells_bufs = None, ()
+        #: the last array's row records (_row_records) and their key
+        self._records_key, self._records_buf = None, None
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
         #: A CPU device (PoCL) writes straight into the caller's array
@@ -271,7 +273,7 @@ class OpenCLBackend:
         import pyopencl as cl
 
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
-        k_tables, k_values = vector.kernels(self.context, self.info, shp)
+        k_tables, k_values, *k_rows = vector.kernels(self.context, self.info, shp)
         n_pd = rect.n_pixels * req.n_dims
         groups = -(-n_pd // vector.LANES)  # vector_tables does 8 (pixel, dimension) pairs per work-item
         pk = self._scratch("vector", groups * vector.LANES * vector.TABLE_WORDS * 4)
@@ -281,10 +283,14 @@ class OpenCLBackend:
         pixels = cl.Buffer(self.context, ro, hostbuf=pixels)
         self._launch_1d(k_tables, groups, pk, pixels, dims, np.uint32(req.seed))
         aij, u, samples = (cl.Buffer(self.context, ro, hostbuf=a) for a in vector.cell_arrays(req, shp))
-        # every row's cells for the later blocks (a placeholder where the request has none)
-        array_a, array_u = self._array_cells(req) if shp.later else (samples, samples)
+        records = rowtab = samples  # placeholders where no dimension lies past block 0
+        if shp.later:
+            # every row's record, and the later blocks' rows of every (pixel, sample position)
+            records = self._row_records(req, shp)
+            rowtab = self._scratch("rows", rect.n_pixels * shp.later_slots * shp.n_k_padded * 4)
+            self._launch_2d_kernel(k_rows[0], shp.later_slots, rect.n_pixels, rowtab, pk, samples)
         self._launch_2d_kernel(k_values, shp.n_blocks, rect.n_pixels,
-                               buf, np.uint32(at), pk, aij, u, samples, array_a, array_u, np.float32(req.jitter))
+                               buf, np.uint32(at), pk, aij, u, samples, rowtab, records, np.float32(req.jitter))
 
     def _launch_vector_baseline(self, req: Request, rect: Rect, shp: vector.BaselineShape, buf, at: int,
                                 dims) -> None:
@@ -365,6 +371,19 @@ class OpenCLBackend:
             self._cells_bufs = tuple(cl.Buffer(self.context, ro, hostbuf=a) for a in array_cells(req))
             self._cells_key = key
         return self._cells_bufs
+
+    def _row_records(self, req: Request, shp: vector.Shape):
+        """The device buffer of :func:`pyoa._opencl.vector.row_records` of
+        ``req``, uploaded once per array and record layout (the last one is
+        kept, as :meth:`_array_cells`). Called with self._lock held."""
+        import pyopencl as cl
+
+        key = (req.construction.name, req.params, shp.cell_bits)
+        if self._records_key != key:
+            ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
+            self._records_buf = cl.Buffer(self.context, ro, hostbuf=vector.row_records(req, shp))
+            self._records_key = key
+        return self._records_buf
 
 
 def _field_tables(q: int) -> tuple[np.ndarray, bool]:

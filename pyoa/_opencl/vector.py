@@ -4,10 +4,14 @@
 offset, number of dimensions and of sample positions), with the shape's
 numbers as ``-D`` constants, so that every loop in it has a constant trip
 count and unrolls, and its stores are generated for exactly that row length
-(:func:`store_code`). A shape is built on first use in a process (about
-0.3 s, plus PoCL's compilation of the two kernels on their first launch,
-which PoCL caches on disk across processes: docs/performance.md, "The
-vector path"), then reused from :data:`_programs`.
+(:func:`store_code`, :func:`group_code`). A shape is built on first use in
+a process (about 0.3 s, plus PoCL's compilation of the kernels on their
+first launch, which PoCL caches on disk across processes: docs/performance.md,
+"The vector path"), then reused from :data:`_programs`. Where a dimension
+lies past block 0, the shape includes the request's dimensions (each one's
+block and column become build constants) and a third kernel,
+``vector_rows``, computes the later blocks' rows once per (pixel, block,
+sample) before the values.
 
 Which requests take it (:func:`shape`): the orthogonal-array samplers, any
 offset, when
@@ -18,9 +22,10 @@ offset, when
   :data:`MAX_WHOLE_ROWS` the kernel holds one vector per dimension and
   stores whole rows; more are computed and stored in groups of 8; the padded
   2D samplers' kernel stops at :data:`MAX_WHOLE_ROWS`),
-- a dimension past the first block finds the cells of every row of the
-  array within :data:`pyoa.request.MAX_ARRAY_CELLS` (it reads its copy at its
-  own rows, docs/spec.md section 6),
+- a dimension past the first block reads its copy at its own rows
+  (docs/spec.md section 6), from the records of every row of the array
+  (:func:`row_records`), which must fit :data:`pyoa.request.MAX_ARRAY_CELLS`
+  words,
 - the stratum permutation fits 4-bit fields (s <= 16) or its bounded walk
   takes at most :data:`MAX_ROUNDS` rounds, and the sub-stratum permutation
   likewise ('cmj' with M <= 16 is tabled; 'mj', 'j' and larger 'cmj' walk per
@@ -42,7 +47,7 @@ import numpy as np
 
 from .. import catalogue_types
 from ..reference.hashes import walk_mask
-from ..request import Rect, Request
+from ..request import MAX_ARRAY_CELLS, Rect, Request
 
 #: Lanes per vector: 8 (AVX2's width; on AVX-512, 16 lanes measured slower).
 LANES = 8
@@ -60,6 +65,11 @@ TABLE_WORDS = 8
 def walk_rounds(n: int) -> int:
     """Rounds that always end a walk of Kensler's permute on ``[0, n)``."""
     return walk_mask(n) + 2 - n
+
+
+def bits(n: int) -> int:
+    """Bits that hold every integer below ``n`` (0 for ``n <= 1``)."""
+    return (n - 1).bit_length() if n > 1 else 0
 
 
 class _Rows:
@@ -84,7 +94,7 @@ class _Rows:
         # whole-row stores, for up to MAX_WHOLE_ROWS dimensions (more go in groups, without them)
         block, tail = store_code(self.n_dims, self.n_k % LANES) if self.n_dims <= MAX_WHOLE_ROWS else (";", ";")
         consts = {**consts, "VND": f"{self.n_dims}u", "VNK": f"{self.n_k}u", "VNKP": f"{self.n_k_padded}u",
-                  "VSTORE_BLOCK": block, "VSTORE_TAIL": tail}
+                  "VSTORE_BLOCK": block, "VSTORE_TAIL": tail, "VSTORE_GROUPS": group_code(self.n_dims)}
         return "".join(f"#define {name} {value}\n" for name, value in consts.items())
 
 
@@ -101,12 +111,40 @@ class Shape(_Rows):
     s_packed: bool
     sub: int  # 0 none, 1 tabled as fields, 2 walked per value
     jkey_bose: bool
-    #: bit d set: requested dimension d lies past block 0 (docs/spec.md section 6), so it reads its own rows
-    later_mask: int = 0
+    #: The request's dimensions when one of them lies past block 0 (docs/spec.md section 6), else ():
+    #: each dimension's block and column are then build constants (:meth:`header`).
+    dims: tuple = ()
 
     @property
     def later(self) -> bool:
-        return self.later_mask != 0
+        """Whether a dimension lies past block 0 and reads its block's own rows."""
+        return any(j >= self.block_dims for j in self.dims)
+
+    @property
+    def slots(self) -> list[int]:
+        """The distinct blocks of :attr:`dims`, in increasing order (kernels/vector.cl's slots)."""
+        return sorted({j // self.block_dims for j in self.dims})
+
+    @property
+    def later_slots(self) -> int:
+        """How many of :attr:`slots` lie past block 0 (each has its rows in vector_rows' table)."""
+        return sum(1 for blk in self.slots if blk > 0)
+
+    @property
+    def a_bits(self) -> int:
+        """Bits of a cell's ``A_ij`` (below s) in a row record (:func:`row_records`)."""
+        return max(1, bits(self.s))
+
+    @property
+    def cell_bits(self) -> int:
+        """Bits of one cell in a row record: ``A_ij``, then ``u`` (below M; none for 'centered')."""
+        return self.a_bits + (bits(self.M) if self.sub else 0)
+
+    @property
+    def record_words(self) -> int:
+        """32-bit words of a row's record: the cells of its ``block_dims`` columns, none split
+        across two words."""
+        return -(-self.block_dims // (32 // self.cell_bits))
 
     @property
     def tabled(self) -> bool:
@@ -127,9 +165,24 @@ class Shape(_Rows):
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
             "VN": f"{self.s * self.M}u", "VWN": f"{walk_mask(self.s * self.M)}u", "VLATER": int(self.later),
-            "VLATER_MASK": f"{self.later_mask:#x}ul",
+            "VNSLOT": f"{len(self.slots)}u", "VLATER0": f"{int(0 in self.slots)}u",
+            "VRW": f"{self.record_words}u", "VCB": f"{self.cell_bits}u", "VCPW": f"{32 // self.cell_bits}u",
+            "VAB": f"{self.a_bits}u", "VAMASK": f"{(1 << self.a_bits) - 1:#x}u",
+            "VUMASK": f"{(1 << (self.cell_bits - self.a_bits)) - 1:#x}u",
             "VGROUPED": int(self.n_dims > MAX_WHOLE_ROWS),
-        })
+        }) + self._slot_tables()
+
+    def _slot_tables(self) -> str:
+        """With later blocks, the ``__constant`` tables of kernels/vector.cl: each slot's first
+        dimension (VSLOT_FIRST), each dimension's slot (VSLOT_OF) and column (VCOL_OF)."""
+        if not self.later:
+            return ""
+        slot = {blk: k for k, blk in enumerate(self.slots)}
+        of = [slot[j // self.block_dims] for j in self.dims]
+        first = [of.index(k) for k in range(len(self.slots))]
+        cols = [j % self.block_dims for j in self.dims]
+        return "".join(f"__constant uint {name}[{len(v)}] = {{{', '.join(f'{x}u' for x in v)}}};\n"
+                       for name, v in (("VSLOT_FIRST", first), ("VSLOT_OF", of), ("VCOL_OF", cols)))
 
 
 @dataclass(frozen=True)
@@ -175,7 +228,7 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     prm = req.params
     if req.construction.family != "oa" or rect.n_k != len(req.samples) or rect.n_k < LANES:
         return None
-    if not 1 <= req.n_dims <= MAX_DIMS or not req.array_cells_fit:
+    if not 1 <= req.n_dims <= MAX_DIMS:
         return None
     s_packed = prm.s <= 16
     if not s_packed and walk_rounds(prm.s) > MAX_ROUNDS:
@@ -188,9 +241,57 @@ def shape(req: Request, rect: Rect) -> Shape | None:
         sub = 2
     else:
         return None
-    return Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
-                 req.construction.partner_cell_key,
-                 sum(1 << d for d, j in enumerate(req.dims.tolist()) if j >= prm.block_dims))
+    dims = tuple(req.dims.tolist())
+    shp = Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
+                req.construction.partner_cell_key, dims if max(dims) >= prm.block_dims else ())
+    if shp.later and prm.s * prm.M * shp.record_words > MAX_ARRAY_CELLS:
+        return None  # the rows' records would not fit
+    return shp
+
+
+def row_records(req: Request, shp: Shape) -> np.ndarray:
+    """The record of every row ``0..N-1`` of the array, for the later blocks of
+    kernels/vector.cl: a C-contiguous uint32 array of shape ``(N,
+    shp.record_words)``.
+
+    The cell of column ``c`` (docs/spec.md section 5: ``A_ij`` and ``u`` of
+    the row, pyoa.constructions' cell functions) is ``A_ij | u << a_bits``,
+    ``cell_bits`` wide, at bit ``(c % per_word) * cell_bits`` of word ``c //
+    per_word``, ``per_word = 32 // cell_bits``; ``u`` is left out for
+    'centered'. A block's rows are a permutation of these rows per (pixel,
+    block), so a later dimension gathers its row's record once per block and
+    8 samples and takes its column's field from it, instead of gathering its
+    own two cells per value."""
+    prm = req.params
+    N = prm.s * prm.M
+    rows = np.arange(N, dtype=np.uint32)[:, None]
+    cols = np.arange(prm.block_dims, dtype=np.uint32)[None, :]
+    aij, u = (np.broadcast_to(c, (N, prm.block_dims)).astype(np.uint32)
+              for c in req.construction.cells(rows, cols, prm))
+    cell = aij | (u << np.uint32(shp.a_bits)) if shp.sub else aij
+    per_word, out = 32 // shp.cell_bits, np.zeros((N, shp.record_words), np.uint32)
+    for c in range(prm.block_dims):
+        out[:, c // per_word] |= cell[:, c] << np.uint32((c % per_word) * shp.cell_bits)
+    return out
+
+
+def group_code(n_dims: int) -> str:
+    """OpenCL statements computing and storing every whole group of 8 of
+    ``n_dims`` dimensions (kernels/vector.cl, VGROUPED): ``V[e] =
+    VALUE_V8(d)`` for the group's 8 dimensions ``d``, then ``store_group``.
+
+    Written out rather than a loop over the groups: with every ``d`` a
+    constant, a dimension's tables, block and column are found at build time,
+    and no more than 8 vectors are live at once (so the program does not
+    spill as a whole unrolled request does). A loop over the groups, with
+    ``d`` only known at run time, ran 36 dimensions at 516-538 M values/s
+    against 657-690 written out (Bose s = 11, 121 spp; Intel Xeon 6/207,
+    2 cores, same process)."""
+    groups = []
+    for g in range(n_dims // LANES):
+        values = " ".join(f"V[{e}] = VALUE_V8({LANES * g + e}u);" for e in range(LANES))
+        groups.append(f"{values} store_group(o + {LANES * g}u, V, {LANES}u, rows);")
+    return " ".join(groups) or ";"
 
 
 def store_code(n_dims: int, tail: int) -> tuple[str, str]:
@@ -226,7 +327,8 @@ def built(context, shp: Shape | BaselineShape) -> bool:
 
 def kernels(context, info, shp: Shape | BaselineShape) -> tuple:
     """``(vector_tables, vector_values)`` built for ``shp`` in ``context``,
-    once per process; ``(vector_baseline,)`` for a :class:`BaselineShape`.
+    once per process, and ``vector_rows`` after them where a dimension lies
+    past block 0; ``(vector_baseline,)`` for a :class:`BaselineShape`.
 
     Raises
     ------
@@ -249,7 +351,8 @@ def kernels(context, info, shp: Shape | BaselineShape) -> tuple:
             except cl.Error as exc:
                 noise = "".join(printed)
                 raise program.BuildError(info, "build", str(exc) + (f"\n{noise}" if noise.strip() else "")) from exc
-            names = ("vector_baseline",) if isinstance(shp, BaselineShape) else ("vector_tables", "vector_values")
+            names = (("vector_baseline",) if isinstance(shp, BaselineShape) else
+                     ("vector_tables", "vector_values") + (("vector_rows",) if shp.later else ()))
             _programs[key] = tuple(cl.Kernel(prg, name) for name in names)
         return _programs[key]
 

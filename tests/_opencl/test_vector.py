@@ -51,6 +51,8 @@ CASES = {
     "bose-s11-grouped": ({"name": "bose", "spp": 121, "dims": 48}, [*range(20, 48), 0, 1, 2, 13, 5, 3, 30, 31, 47]),
     # a whole grouped request of a walked sub-stratum: groups of 8, 8 and a tail of 7, blocks 0-3 of 6
     "bush-s5-t3-23": ({"name": "bush", "spp": 125, "strength": 3, "dims": 23}, None),
+    # no dimension of block 0 (every slot's rows from vector_rows), blocks 1, 3 and 2 out of order
+    "bose-s11-later-only": ({"name": "bose", "spp": 121, "dims": 48}, [12, 40, 47, 13, 30, 24, 25]),
 }
 CASE_PIXELS = [0, 7, U32_MAX]
 
