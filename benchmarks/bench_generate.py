@@ -501,9 +501,15 @@ def ceiling_notes(report: dict, rate: dict) -> list[str]:
             closer = "compute (the cores' arithmetic)" if got / cap > got / fill else "memory (fill)"
             far = f", though far from both (at most {max(got / cap, got / fill):.2f} of either)" if max(
                 got / cap, got / fill) < 0.5 else ""
+            sim = c.get("simulated_ceiling_values_per_s")
+            # The block throughput assumes every instruction issues as soon as a port is free; llvm-mca's
+            # simulation of the loop also waits for each instruction's operands (docs/performance.md,
+            # "What bounds generation": measured rates sit at 0.7-0.9 of it)
+            simulated = (f"; {got / sim:.2f} of llvm-mca's simulation of the loop, dependencies included "
+                         f"({_m(sim)} M values/s)") if sim else ""
             notes.append(f"- {case} / opencl: {got / fill:.2f} of fill ({_m(fill)} M values/s) and {got / cap:.2f} "
                          f"of the compute ceiling ({_m(cap)} M values/s = {how}): closer to the {closer} "
-                         f"bound{far}")
+                         f"bound{far}{simulated}")
         else:
             notes.append(f"- {case} / opencl: {got / cap:.2f} of the compute ceiling ({_m(cap)} M values/s = "
                          f"{how}); no fill row in this run to compare with")

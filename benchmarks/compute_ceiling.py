@@ -52,7 +52,10 @@ workload ``bose``, 121 spp, 10 dims, ``cmj``):
    (and those addressed from ``%rsp``/``%rbp``: spills and private arrays),
    gathers and divisions (``vdivps``: the correctly rounded float divisions
    of docs/spec.md section 7, four per dimension, one per 5 cycles in
-   LLVM's Skylake-server model, the bound of 10 and 12 dimensions).
+   LLVM's Skylake-server model: the block-throughput bound of 10 and 12
+   dimensions; llvm-mca's simulation, which also waits for operands, and
+   the probes of docs/performance.md, "What bounds generation", say the
+   dependency chains bind first).
 4. ``llvm-mca-15 -mcpu=<cpu>`` runs on the path (branches kept, aimed at
    the path's start) for the host CPU's model in LLVM 15's naming
    (``host_mcpu``: e.g. Intel family 6 model 207, Emerald Rapids, is
