@@ -277,9 +277,13 @@ def _bound(backend: str, child: dict, spp: int, dims: int, pixels: int) -> dict:
         chunk = 4 * min(chunk_values, spp * dims * pixels)
         chunk_pixels = min(pixels, chunk_values // (spp * dims) + 2)
         terms = {"output chunk buffer": chunk, "table buffer (at most one chunk)": chunk,
+                 # a later block's rows per (pixel, sample position padded to 8): blocks <= dims, and the
+                 # padding is below the 8 or more positions, so under twice the chunk
+                 "later blocks' rows (vector_rows: under twice the chunk)": 2 * chunk,
                  "table keys of one chunk (x2 for host temporaries)": 2 * 12 * chunk_pixels * dims,
                  "request index arrays": index}
-        stated = "one output chunk (256 MiB) + one table buffer no larger than its chunk + small per-launch arrays"
+        stated = ("one output chunk (256 MiB) + one table buffer no larger than its chunk + the later blocks' "
+                  "rows, under twice the chunk + small per-launch arrays")
     else:
         chunk_values = child.get("chunk_values") or (1 << 20)
         n_chunks = -(-pixels * spp // max(1, chunk_values // dims))
