@@ -378,11 +378,11 @@ def blocks(insns: list[Insn]) -> dict[int, Block]:
     return out
 
 
-def dominators(bl: dict[int, Block], entry: int) -> dict[int, set[int]]:
-    """Each reachable block's dominators (iterative data flow; a few hundred blocks)."""
-    order, seen, stack = [], set(), [(entry, iter(bl[entry].succs))]
-    seen.add(entry)
-    while stack:  # post-order
+def post_order(start: int, succs) -> list[int]:
+    """The nodes reachable from ``start`` in depth-first post-order (successors before their
+    predecessors, back edges aside), iteratively: ``succs(n)`` lists the successors of ``n``."""
+    order, seen, stack = [], {start}, [(start, iter(succs(start)))]
+    while stack:
         node, it = stack[-1]
         nxt = next((s for s in it if s not in seen), None)
         if nxt is None:
@@ -390,8 +390,13 @@ def dominators(bl: dict[int, Block], entry: int) -> dict[int, set[int]]:
             stack.pop()
         else:
             seen.add(nxt)
-            stack.append((nxt, iter(bl[nxt].succs)))
-    rpo = order[::-1]
+            stack.append((nxt, iter(succs(nxt))))
+    return order
+
+
+def dominators(bl: dict[int, Block], entry: int) -> dict[int, set[int]]:
+    """Each reachable block's dominators (iterative data flow; a few hundred blocks)."""
+    rpo = post_order(entry, lambda b: bl[b].succs)[::-1]
     preds: dict[int, list[int]] = {b: [] for b in rpo}
     for b in rpo:
         for s in bl[b].succs:
@@ -538,22 +543,7 @@ def _path(bl: dict[int, Block], loop: Loop, trips: dict[int, int]) -> list[Insn]
         return out
 
     # longest path in the DAG of the body without the back edges (topological order by DFS)
-    order, seen = [], set()
-
-    def visit(n: int) -> None:
-        stack = [(n, iter(succs(n)))]
-        seen.add(n)
-        while stack:
-            cur, it = stack[-1]
-            nxt = next((s for s in it if s not in seen), None)
-            if nxt is None:
-                order.append(cur)
-                stack.pop()
-            else:
-                seen.add(nxt)
-                stack.append((nxt, iter(succs(nxt))))
-
-    visit(loop.header)
+    order = post_order(loop.header, succs)
     best: dict[int, tuple[int, int | None]] = {}  # node -> (length of the longest path from it, next node)
     latches = {node(u) for u in loop.latches}
     for n in order:  # successors first

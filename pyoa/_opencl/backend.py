@@ -78,10 +78,8 @@ class OpenCLBackend:
         self._fields: dict[int, tuple] = {}
         self._consts: dict[tuple, object] = {}
         self._scratch_bufs: dict[str, object] = {}
-        #: the last request shape's array cells (_array_cells) and its key
-        self._cells_key, self._cells_bufs = None, ()
-        #: the last array's row records (_row_records) and their key
-        self._records_key, self._records_buf = None, None
+        #: name -> (key, device buffers) of the last upload of each kind (_kept_upload)
+        self._uploads: dict[str, tuple] = {}
         limit = min(MAX_CHUNK_BYTES, int(self.info.device.max_mem_alloc_size), 2**31 - 1)
         self.max_chunk_values = limit // 4
         #: A CPU device (PoCL) writes straight into the caller's array
@@ -357,34 +355,33 @@ class OpenCLBackend:
             np.float32(req.jitter),
         )
 
-    def _array_cells(self, req: Request) -> tuple:
-        """Device buffers of :func:`pyoa.host_tables.array_cells` of ``req``,
-        uploaded once per request shape (the last one is kept: a render asks
-        for the same shape batch after batch). Called with self._lock held."""
+    def _kept_upload(self, name: str, key, arrays) -> tuple:
+        """Read-only device buffers of the host arrays ``arrays()``, uploaded
+        once per ``key`` and kept under ``name`` until another key comes (a
+        render asks for the same shape batch after batch). Called with
+        self._lock held."""
         import pyopencl as cl
 
+        kept = self._uploads.get(name)
+        if kept is None or kept[0] != key:
+            ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
+            kept = self._uploads[name] = (key, tuple(cl.Buffer(self.context, ro, hostbuf=a) for a in arrays()))
+        return kept[1]
+
+    def _array_cells(self, req: Request) -> tuple:
+        """Device buffers of :func:`pyoa.host_tables.array_cells` of ``req``,
+        uploaded once per request shape. Called with self._lock held."""
         from ..host_tables import array_cells
 
-        key = (req.construction.name, req.params, req.offset, req.dims.tobytes())
-        if self._cells_key != key:
-            ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
-            self._cells_bufs = tuple(cl.Buffer(self.context, ro, hostbuf=a) for a in array_cells(req))
-            self._cells_key = key
-        return self._cells_bufs
+        return self._kept_upload("cells", (req.construction.name, req.params, req.offset, req.dims.tobytes()),
+                                 lambda: array_cells(req))
 
     def _row_records(self, req: Request, shp: vector.Shape):
         """The device buffer of :func:`pyoa._opencl.vector.row_records` of
-        ``req``, uploaded once per array and record layout (the last one is
-        kept, as :meth:`_array_cells`). Called with self._lock held."""
-        import pyopencl as cl
-
-        key = (req.construction.name, req.params, shp.cell_bits)
-        if self._records_key != key:
-            ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
-            self._records_buf = cl.Buffer(self.context, ro, hostbuf=vector.row_records(req, shp))
-            self._records_key = key
-        return self._records_buf
-
+        ``req``, uploaded once per array and record layout. Called with
+        self._lock held."""
+        return self._kept_upload("records", (req.construction.name, req.params, shp.cell_bits),
+                                 lambda: (vector.row_records(req, shp),))[0]
 
 def _field_tables(q: int) -> tuple[np.ndarray, bool]:
     """GF(q) as the kernels read it: addition then multiplication table, or a

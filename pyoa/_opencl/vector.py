@@ -360,12 +360,18 @@ def kernels(context, info, shp: Shape | BaselineShape) -> tuple:
 def cell_arrays(req: Request, shp: Shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(A_ij, u, sample indices)`` of every sample position, the cells laid
     out ``[d][k]`` and every row padded with zeros to whole blocks (the
-    kernel's ``vload8`` reads whole blocks; padded lanes are never stored)."""
+    kernel's ``vload8`` reads whole blocks; padded lanes are never stored).
+    With a dimension past block 0 the kernel reads every cell from the row
+    records (:func:`row_records`) instead, and the cells are one-entry
+    placeholders."""
     from ..host_tables import cells
 
-    aij, u = cells(req, 0, shp.n_k)
     pad = shp.n_k_padded - shp.n_k
     samples = np.pad(req.samples, (0, pad))
+    if shp.later:
+        unused = np.zeros((1, 1), np.uint32)
+        return unused, unused, np.ascontiguousarray(samples, dtype=np.uint32)
+    aij, u = cells(req, 0, shp.n_k)
     return (np.ascontiguousarray(np.pad(aij, ((0, 0), (0, pad)))),
             np.ascontiguousarray(np.pad(u, ((0, 0), (0, pad)))),
             np.ascontiguousarray(samples, dtype=np.uint32))

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from pyoa import reference as ref
+from pyoa.request import MAX_ARRAY_CELLS
 from tests.helpers import U32_MAX, assert_same_bits, make
 
 pytestmark = pytest.mark.opencl
@@ -168,6 +169,12 @@ def test_vector_path_taken_where_expected():
     assert "#define VGROUPED 0" in shape_of("bose", 121, vector.MAX_WHOLE_ROWS).header()
     assert "#define VGROUPED 1" in shape_of("bose", 121, vector.MAX_WHOLE_ROWS + 1).header()
     assert not shape_of("bose", 121, 12).later and shape_of("bose", 121, 13).later
+    # later blocks read the array's row records, which must fit MAX_ARRAY_CELLS words: Bush s = 16,
+    # t = 5 (N = 2^20, 17 columns of 20-bit cells, one per word) fits without a later block only
+    bush = {"strength": 5, "pixels": (0,)}
+    assert shape_of("bush", 16**5, 17, **bush) is not None
+    assert shape_of("bush", 16**5, 18, **bush) is None
+    assert 16**5 * 17 > MAX_ARRAY_CELLS
     # a comparison sampler never
     assert shape_of("sobol", 64, 4) is None
     assert shape_of("halton", 64, 4) is None
