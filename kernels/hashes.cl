@@ -51,6 +51,36 @@ UT permute_round##SFX(UT i, UT p, uint w)                                       
 DEFINE_PERMUTE_ROUND(, uint)
 DEFINE_PERMUTE_ROUND(_v8, uint8)
 
+/* permute_round in 16-bit lanes, for w < 2^16: every step of the round only
+ * carries information upward (multiplications, xors, and right shifts of
+ * i & w), so the low 16 bits of each intermediate are those of the 32-bit
+ * round, and so is the result masked by w. Half the bits per lane: twice the
+ * lanes per vector register, and a 16-bit multiply (vpmullw: one micro-op,
+ * latency 5 on x86) where the 32-bit one takes two (latency 10). The seed
+ * stays 32-bit: its parts (p, p >> 16, ...) are truncated after the shifts,
+ * and the round's two consecutive multiplications, by 1 | p >> 27 and by
+ * 0x6935fa69, are one by their product. Instances: 16 lanes with one seed
+ * (the rows' walks), 8 lanes with their own seeds (the tables), as
+ * DEFINE_PERMUTE_ROUND above. */
+#define DEFINE_PERMUTE_ROUND16(SFX, HT, ST, CVT)                                        \
+HT permute_round16##SFX(HT i, ST p, ushort w)                                           \
+{                                                                                       \
+    i ^= CVT(p);        i *= (ushort)0xe170893du;                                       \
+    i ^= CVT(p >> 16);                                                                  \
+    i ^= (i & w) >> 4;                                                                  \
+    i ^= CVT(p >> 8);   i *= (ushort)0x0929eb3fu;                                       \
+    i ^= CVT(p >> 23);                                                                  \
+    i ^= (i & w) >> 1;  i *= CVT((1u | (p >> 27)) * 0x6935fa69u);                       \
+    i ^= (i & w) >> 11; i *= (ushort)0x74dcb303u;                                       \
+    i ^= (i & w) >> 2;  i *= (ushort)0x9e501cc3u;                                       \
+    i ^= (i & w) >> 2;  i *= (ushort)0xc860a3dfu;                                       \
+    i &= w;                                                                             \
+    i ^= i >> 5;                                                                        \
+    return i;                                                                           \
+}
+DEFINE_PERMUTE_ROUND16(_v16, ushort16, uint, (ushort))
+DEFINE_PERMUTE_ROUND16(_v8, ushort8, uint8, convert_ushort8)
+
 /* w = the all-ones mask just covering l - 1 (the walk's domain [0, w]). */
 uint walk_mask(uint l)
 {
@@ -94,28 +124,37 @@ FT randfloat##SFX(UT i, uint p)                                                 
 DEFINE_RANDFLOAT(, uint, float, convert_float_rte)
 DEFINE_RANDFLOAT(_v8, uint8, float8, convert_float8_rte)
 
-/* Wellons' lowbias32. */
-uint mix32(uint x)
-{
-    x ^= x >> 16; x *= 0x7feb352du;
-    x ^= x >> 15; x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
+/* Wellons' lowbias32, the pair hash and the seeds of docs/spec.md sections
+ * 3 and 6 built on it. Scalar and 8-lane instances (lanes with their own
+ * arguments: vector_tables derives 8 (pixel, dimension) pairs' seeds at
+ * once), as above; a lane's condition is written as a comparison, since a
+ * vector ?: selects by each lane's top bit, not by its being nonzero.
+ * block_order_seed is the seed of block `block`'s sample order (section 6):
+ * 0 for block 0 (permute with seed 0 is the identity), else never 0. */
+#define DEFINE_SEEDS(SFX, UT)                                                           \
+UT mix32##SFX(UT x)                                                                     \
+{                                                                                       \
+    x ^= x >> 16; x *= 0x7feb352du;                                                     \
+    x ^= x >> 15; x *= 0x846ca68bu;                                                     \
+    x ^= x >> 16;                                                                       \
+    return x;                                                                           \
+}                                                                                       \
+UT hash_pair##SFX(UT a, UT b, uint key)                                                 \
+{                                                                                       \
+    UT h = mix32##SFX(b ^ mix32##SFX(a ^ key));                                         \
+    return (h != 0u) ? h : (UT)key;                                                     \
+}                                                                                       \
+UT pixel_seed##SFX(uint seed, UT pixel) { return hash_pair##SFX((UT)seed, pixel, PIXEL_KEY); } \
+UT block_seed##SFX(UT p, UT block)                                                      \
+{                                                                                       \
+    return (block != 0u) ? hash_pair##SFX(p, block, BLOCK_KEY) : p;                     \
+}                                                                                       \
+UT block_order_seed##SFX(UT P, UT block, uint N)                                        \
+{                                                                                       \
+    return (block != 0u) ? hash_pair##SFX(P, (UT)N, BLOCK_ORDER_KEY) : (UT)0u;          \
 }
-
-uint hash_pair(uint a, uint b, uint key)
-{
-    uint h = mix32(b ^ mix32(a ^ key));
-    return h ? h : key;
-}
-
-uint pixel_seed(uint seed, uint pixel) { return hash_pair(seed, pixel, PIXEL_KEY); }
-
-uint block_seed(uint p, uint block) { return block ? hash_pair(p, block, BLOCK_KEY) : p; }
-
-/* The seed of block `block`'s sample order (docs/spec.md section 6): 0 for
- * block 0 (permute with seed 0 is the identity), else never 0. */
-uint block_order_seed(uint P, uint block, uint N) { return block ? hash_pair(P, N, BLOCK_ORDER_KEY) : 0u; }
+DEFINE_SEEDS(, uint)
+DEFINE_SEEDS(_v8, uint8)
 
 /* The row of sample i in a block whose order seed is r: two permutations
  * with independent seeds (pyoa.reference.hashes.block_row says why), the

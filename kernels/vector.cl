@@ -77,7 +77,8 @@ static inline __attribute__((always_inline)) uint8 gather_v8(__global const uint
 uint8 field4_v8(uint8 lo, uint8 hi, uint8 a) { return (((a < 8u) ? lo : hi) >> ((a & 7u) * 4u)) & 15u; }
 
 /* The permutations of [0, l) with seeds p (l <= w + 1 <= 16), one per lane,
- * as 4-bit fields: permute_round of every x in [0, w] once, then each
+ * as 4-bit fields: permute_round of every x in [0, w] once (in 16-bit
+ * lanes, permute_round16), then each
  * entry's bounded walk through that table (at most w + 1 - l steps, see
  * permute_bounded_v8), then the final shift. */
 static inline __attribute__((always_inline)) void permutation_fields_v8(uint l, uint w, uint8 p, uint8 *lo_out, uint8 *hi_out)
@@ -85,7 +86,7 @@ static inline __attribute__((always_inline)) void permutation_fields_v8(uint l, 
     uint8 rlo = 0u, rhi = 0u;
     #pragma unroll
     for (uint x = 0u; x <= w; ++x) {  /* w and l are build constants: every loop unrolls */
-        uint8 r = permute_round_v8((uint8)x, p, w) << (4u * (x & 7u));
+        uint8 r = convert_uint8(permute_round16_v8((ushort8)(ushort)x, p, (ushort)w)) << (4u * (x & 7u));
         if (x < 8u) rlo |= r; else rhi |= r;
     }
     uint8 sh = p % l, lo = 0u, hi = 0u;
@@ -119,15 +120,10 @@ __kernel void vector_tables(__global uint *restrict pk,
                             const uint seed)
 {
     uint g = (uint)get_global_id(0);
-    uint qs[8], os[8];
-    #pragma unroll
-    for (uint r = 0u; r < 8u; ++r) {
-        uint pd = 8u * g + r, j = dims[pd % VND];
-        uint P = block_seed(pixel_seed(seed, pixels[pd / VND]), j / VDMAX);
-        qs[r] = P * (j % VDMAX + 1u);
-        os[r] = block_order_seed(P, j / VDMAX, VN);
-    }
-    uint8 q = vload8(0, qs);
+    uint8 pd = 8u * g + (uint8)(0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u), pix = pd / VND;
+    uint8 j = gather_v8(dims, pd - pix * VND), block = j / VDMAX;
+    uint8 P = block_seed_v8(pixel_seed_v8(seed, gather_v8(pixels, pix)), block);
+    uint8 q = P * (j - block * VDMAX + 1u), os = block_order_seed_v8(P, block, VN);
     uint8 w0 = q * STRATUM_KEY, w1 = 0u, w2 = q * SUBSTRATUM_KEY, w3 = 0u, w4 = q * JITTER_KEY;
 #if VS_PACKED
     permutation_fields_v8(VS, VWS, q * STRATUM_KEY, &w0, &w1);
@@ -154,9 +150,11 @@ __kernel void vector_tables(__global uint *restrict pk,
  * block, sample) only: vector_rows computes them beforehand, and
  * vector_values loads them once per work-item and block (slot), before any
  * value, with the records of those rows (rows, rec: see locate_slots). A
- * dimension then takes its cell from its column's field of its block's
- * record, two shifts and masks, and the code that computes values is the
- * same straight line for every dimension. (Before, a later dimension walked
+ * later dimension then takes its cell from its column's field of its block's
+ * record, two shifts and masks, and a block-0 dimension loads it from
+ * cell_a and cell_u as without VLATER (a gather of block 0's records cost
+ * the 36-dimension request about 3 % of its values kernel); the code that
+ * computes values is the same straight line for every dimension. (Before, a later dimension walked
  * its block's rows inside this kernel, once per block and 8 samples, and
  * gathered its own two cells per value: 36 dimensions ran at 0.57-0.62x the
  * values/s of 12, docs/performance.md.) */
@@ -166,20 +164,21 @@ static inline __attribute__((always_inline)) float8 value_v8(
     const uint8 *rows, const uint8 *rec)
 {
     __global const uint *w = pk + 8u * (pl * VND + d);
-#if VLATER
-    uint slot = VSLOT_OF[d], col = VCOL_OF[d];
-    uint8 row = rows[slot];
-    uint8 field = rec[slot * VRW + col / VCPW] >> ((col % VCPW) * VCB);
-    uint8 aij = field & VAMASK;
-#if VSUB != 0
-    uint8 u = (field >> VAB) & VUMASK;
-#endif
-#else
     uint8 row = i;
     uint8 aij = vload8(b, cell_a + d * VNKP);
 #if VSUB != 0
     uint8 u = vload8(b, cell_u + d * VNKP);
 #endif
+#if VLATER
+    uint slot = VSLOT_OF[d], col = VCOL_OF[d];  /* constants: d is after unrolling */
+    if (slot >= VLATER0) {  /* past block 0; block 0's cells are the request's, as without VLATER */
+        row = rows[slot];
+        uint8 field = rec[slot * VRW + col / VCPW] >> ((col % VCPW) * VCB);
+        aij = field & VAMASK;
+#if VSUB != 0
+        u = (field >> VAB) & VUMASK;
+#endif
+    }
 #endif
 #if VS_PACKED
     uint8 stratum = field4_v8((uint8)w[0], (uint8)w[1], aij);
@@ -211,36 +210,72 @@ static inline __attribute__((always_inline)) float8 value_v8(
 }
 
 #if VLATER
-/* vector_rows without a table walks the rows of the VNKP sample positions in
- * chunks of this many 8-lane vectors. */
+/* vector_rows walks the rows of the VNKP sample positions in chunks of this
+ * many 16-lane vectors. */
 #define WALK_VECTORS 8u
 
 /* Kensler's permute on [0, VN) with seed p != 0 of WALK_VECTORS vectors x at
- * once: one cycle walk for all of them (a loop until every lane of every
- * vector is below VN), then the final shift. A walk is a chain of dependent
- * multiplications repeated until its slowest lane lands; eight independent
- * chains in one loop overlap and share that wait. */
-static inline __attribute__((always_inline)) void permute_walks(uint8 *x, uint p)
+ * once, the final shift included, in 16-bit lanes (permute_round16: the
+ * host builds this kernel only for N <= 2^16).
+ *
+ * Where the walk's domain [0, VWN] has at most 16 values at or above VN
+ * (VNOUT = VWN + 1 - VN <= 16: N = 121, 125, 25, 49, ...), a walk is one
+ * round and a lookup: the round of x < VN lands either below VN (the walk
+ * ends) or on one of the VNOUT out values y, and from y the walk goes on
+ * exactly as a walk started at y would, to a fixed W(y) < VN. So the VNOUT
+ * results W are walked first, once per seed, and each x then takes its
+ * round, then W of it where the round left [0, VN) (a select per out value:
+ * PoCL scalarizes shuffle). The same bits as permute_walk, at one round per
+ * sample instead of about two: a loop until every lane is in ran a second
+ * round almost always (each lane leaves with probability VNOUT / (VWN + 1),
+ * 0.05 for N = 121, so one of 64 lanes did 95 % of the time).
+ *
+ * Otherwise one cycle walk for all vectors (a loop until every lane of every
+ * vector is below VN): a walk is a chain of dependent multiplications
+ * repeated until its slowest lane lands; independent chains in one loop
+ * overlap and share that wait. */
+#define VNOUT (VWN + 1u - VN)
+static inline __attribute__((always_inline)) void permute_walks(ushort16 *x, uint p)
 {
-    uint8 P = (uint8)p;
+    const ushort n = (ushort)VN, w = (ushort)VWN;
+#if VNOUT <= 16u
+    /* W(y) of y = VN + lane (lanes past VWN repeat VWN and are never read).
+     * A y on a cycle of out values only is never reached from below VN (the
+     * walk from x < VN stays on x's own cycle) and its walk would not end:
+     * from any other y, at most VNOUT rounds lead below VN. */
+    ushort16 wo = min((ushort16)n + (ushort16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15), (ushort16)w);
+    wo = permute_round16_v16(wo, p, w);
+    for (uint r = 1u; r < VNOUT && any(wo >= n); ++r)
+        wo = (wo < n) ? wo : permute_round16_v16(wo, p, w);
+    #pragma unroll
+    for (uint c = 0u; c < WALK_VECTORS; ++c) {
+        ushort16 y = permute_round16_v16(x[c], p, w), z = y;
+        #pragma unroll
+        for (uint o = 0u; o < VNOUT; ++o)
+            z = (y == (ushort)(VN + o)) ? (ushort16)wo[o] : z;
+        x[c] = z;
+    }
+#else
     #pragma unroll
     for (uint c = 0u; c < WALK_VECTORS; ++c)
-        x[c] = permute_round_v8(x[c], P, VWN);
+        x[c] = permute_round16_v16(x[c], p, w);
     for (;;) {
-        int8 out = 0;
+        short16 out = 0;
         #pragma unroll
         for (uint c = 0u; c < WALK_VECTORS; ++c)
-            out |= x[c] >= VN;
+            out |= x[c] >= n;
         if (!any(out))
             break;
         #pragma unroll
         for (uint c = 0u; c < WALK_VECTORS; ++c)
-            x[c] = (x[c] < VN) ? x[c] : permute_round_v8(x[c], P, VWN);
+            x[c] = (x[c] < n) ? x[c] : permute_round16_v16(x[c], p, w);
     }
+#endif
+    const ushort sh = (ushort)(p % VN);
     #pragma unroll
     for (uint c = 0u; c < WALK_VECTORS; ++c) {
-        x[c] += p % VN;
-        x[c] = (x[c] >= VN) ? x[c] - VN : x[c];
+        x[c] += sh;
+        x[c] = (x[c] >= n) ? x[c] - n : x[c];
     }
 }
 
@@ -251,7 +286,7 @@ static inline __attribute__((always_inline)) void permute_walks(uint8 *x, uint p
  * sample) only, so they are computed here once, not inside vector_values
  * (there, a walk per block and 8 samples ran one chain of rounds at a time:
  * about a fifth of a 36-dimension request's time, docs/performance.md).
- * WALK_VECTORS vectors at a time (permute_walks). */
+ * WALK_VECTORS vectors of 16 at a time (permute_walks). */
 __kernel void vector_rows(__global uint *restrict rowtab,
                           __global const uint *restrict pk,
                           __global const uint *restrict isamp)
@@ -259,23 +294,31 @@ __kernel void vector_rows(__global uint *restrict rowtab,
     uint k = (uint)get_global_id(0), pl = (uint)get_global_id(1);
     uint order = pk[8u * (pl * VND + VSLOT_FIRST[VLATER0 + k]) + 5u];  /* never 0 past block 0 */
     __global uint *o = rowtab + (pl * (VNSLOT - VLATER0) + k) * VNKP;
-    for (uint c0 = 0u; c0 < VNKP / 8u; c0 += WALK_VECTORS) {
-        uint8 x[WALK_VECTORS];
+    #define VNV16 ((VNKP + 15u) / 16u)  /* 16-lane vectors of sample positions */
+    for (uint c0 = 0u; c0 < VNV16; c0 += WALK_VECTORS) {
+        ushort16 x[WALK_VECTORS];
         #pragma unroll
-        for (uint c = 0u; c < WALK_VECTORS; ++c)  /* past the last vector: repeat it (not stored) */
-            x[c] = vload8(min(c0 + c, VNKP / 8u - 1u), isamp);
+        for (uint c = 0u; c < WALK_VECTORS; ++c) {  /* past the last vector: repeat it (not stored) */
+            uint v = min(c0 + c, VNV16 - 1u);
+            x[c] = convert_ushort16((uint16)(vload8(min(2u * v, VNKP / 8u - 1u), isamp),
+                                             vload8(min(2u * v + 1u, VNKP / 8u - 1u), isamp)));
+        }
         permute_walks(x, order);
         permute_walks(x, mix32(order));
         #pragma unroll
-        for (uint c = 0u; c < WALK_VECTORS; ++c)
-            if (c0 + c < VNKP / 8u)
-                vstore8(x[c], c0 + c, o);
+        for (uint c = 0u; c < WALK_VECTORS; ++c) {
+            uint16 r = convert_uint16(x[c]);
+            if (2u * (c0 + c) < VNKP / 8u)
+                vstore8(r.lo, 2u * (c0 + c), o);
+            if (2u * (c0 + c) + 1u < VNKP / 8u)
+                vstore8(r.hi, 2u * (c0 + c) + 1u, o);
+        }
     }
 }
 
-/* The rows of samples i (8 lanes) in every block of the request (slot k:
- * rows[k]; block 0's rows are i, later blocks' from vector_rows) and their
- * records (rec[k VRW + word]: pyoa._opencl.vector.row_records, the cells of
+/* The rows of samples i (8 lanes) in every later block of the request (slot
+ * k >= VLATER0: rows[k], from vector_rows; block 0's rows are i, and its
+ * cells the request's cell_a and cell_u) and their records (rec[k VRW + word]: pyoa._opencl.vector.row_records, the cells of
  * every column of a row, packed), for pixel pl. */
 static inline __attribute__((always_inline)) void locate_slots(
     uint b, uint pl, uint8 i, __global const uint *restrict rowtab, __global const uint *restrict records,
@@ -283,11 +326,13 @@ static inline __attribute__((always_inline)) void locate_slots(
 {
     #pragma unroll
     for (uint k = 0u; k < VNSLOT; ++k) {
-        uint8 r = (k < VLATER0) ? i : vload8(b, rowtab + (pl * (VNSLOT - VLATER0) + k - VLATER0) * VNKP);
-        rows[k] = r;
-        #pragma unroll
-        for (uint q = 0u; q < VRW; ++q)
-            rec[k * VRW + q] = gather_v8(records + q, r * VRW);
+        if (k >= VLATER0) {  /* block 0 (slot 0 where VLATER0) reads the request's cells instead */
+            uint8 r = vload8(b, rowtab + (pl * (VNSLOT - VLATER0) + k - VLATER0) * VNKP);
+            rows[k] = r;
+            #pragma unroll
+            for (uint q = 0u; q < VRW; ++q)
+                rec[k * VRW + q] = gather_v8(records + q, r * VRW);
+        }
     }
 }
 #define SLOT_STATE uint8 slot_rows[VNSLOT], slot_rec[VNSLOT * VRW]; \

@@ -58,6 +58,11 @@ MAX_DIMS = 64
 MAX_WHOLE_ROWS = 16
 #: Most rounds of a bounded walk (l = 17 in [0, 31] needs 16).
 MAX_ROUNDS = 16
+
+#: ``vector_rows`` walks the later blocks' rows in 16-bit lanes
+#: (``permute_round16`` of kernels/hashes.cl), so a request with a dimension
+#: past block 0 takes the vector path only for arrays of fewer rows N = s M.
+MAX_ROWS16 = 1 << 16
 #: Words of the per-(pixel, dimension) table (kernels/vector.cl, vector_tables).
 TABLE_WORDS = 8
 
@@ -246,6 +251,8 @@ def shape(req: Request, rect: Rect) -> Shape | None:
                 req.construction.partner_cell_key, dims if max(dims) >= prm.block_dims else ())
     if shp.later and prm.s * prm.M * shp.record_words > MAX_ARRAY_CELLS:
         return None  # the rows' records would not fit
+    if shp.later and prm.s * prm.M >= MAX_ROWS16:
+        return None  # vector_rows walks in 16-bit lanes
     return shp
 
 
@@ -361,16 +368,12 @@ def cell_arrays(req: Request, shp: Shape) -> tuple[np.ndarray, np.ndarray, np.nd
     """``(A_ij, u, sample indices)`` of every sample position, the cells laid
     out ``[d][k]`` and every row padded with zeros to whole blocks (the
     kernel's ``vload8`` reads whole blocks; padded lanes are never stored).
-    With a dimension past block 0 the kernel reads every cell from the row
-    records (:func:`row_records`) instead, and the cells are one-entry
-    placeholders."""
+    A dimension past block 0 reads its cells from its block's row records
+    (:func:`row_records`) instead, and its row here is never read."""
     from ..host_tables import cells
 
     pad = shp.n_k_padded - shp.n_k
     samples = np.pad(req.samples, (0, pad))
-    if shp.later:
-        unused = np.zeros((1, 1), np.uint32)
-        return unused, unused, np.ascontiguousarray(samples, dtype=np.uint32)
     aij, u = cells(req, 0, shp.n_k)
     return (np.ascontiguousarray(np.pad(aij, ((0, 0), (0, pad)))),
             np.ascontiguousarray(np.pad(u, ((0, 0), (0, pad)))),

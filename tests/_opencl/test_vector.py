@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from pyoa import reference as ref
+from pyoa.reference import hashes as ref_hashes
 from pyoa.request import MAX_ARRAY_CELLS
 from tests.helpers import U32_MAX, assert_same_bits, make
 
@@ -307,6 +308,49 @@ def test_vector_edges_bose(monkeypatch, backends, offset):
         vector_compare(monkeypatch, be, smp, [3], [7, 7, 0, 0, 120, 120, 5, 5, 9], dims, "repeated samples")
     smp = make("bose", 64, 16, seed=U32_MAX, offset=offset, jitter=0.5, backend="numpy")
     vector_compare(monkeypatch, be, smp, pixels, None, None, "GF(8), 64 samples")
+
+
+def has_out_only_cycle(p: int, N: int) -> bool:
+    """Whether Kensler's round with seed ``p`` on ``[0, walk_mask(N)]`` has a
+    cycle of values ``>= N`` only: from any other value ``>= N`` at most
+    ``walk_mask(N) + 1 - N`` rounds lead below ``N``."""
+    w = ref_hashes.walk_mask(N)
+    for y in range(N, w + 1):
+        x = y
+        for _ in range(w + 1 - N):
+            x = ref_hashes.permute_round(x, p, w)
+            if x < N:
+                break
+        else:
+            return True
+    return False
+
+
+@pytest.mark.parametrize("spp", [121, 49, 169])
+def test_vector_rows_walks_where_round_values_leave_the_range(monkeypatch, backends, spp):
+    """vector_rows walks a later block's rows in one round and a lookup where
+    at most 16 values of the walk's domain lie at or above N (N = 121: 7 of
+    [0, 127]; N = 49: 15 of [0, 63]), and in a loop of rounds otherwise (N =
+    169: 87 of [0, 255]). The lookup's results are walked once per seed from
+    each of those values, and a value on a cycle of such values only
+    (permute_round(y) = y, say) has no result: its walk is cut short, since no
+    sample reaches it. Pixels whose block-1 or block-2 order seeds have such a
+    cycle, and pixels whose seeds have none, give the NumPy bits."""
+    be = backends["vector"]
+    s = math.isqrt(spp)
+    seed = 77
+    smp = make("bose", spp, 3 * (s + 1), seed=seed, offset="cmj", backend="numpy")
+
+    def cyclic(pixel):
+        P = ref.pixel_seed(seed, pixel)
+        orders = [ref_hashes.block_order_seed(ref.block_seed(P, b), b, spp) for b in (1, 2)]
+        return any(has_out_only_cycle(r, spp) or has_out_only_cycle(ref.mix32(r), spp) for r in orders)
+
+    found = [px for px in range(3000) if cyclic(px)][:4]
+    assert len(found) == 4  # about 5 % of seeds (N = 121) have a fixed point past N
+    pixels = found + [px for px in range(20) if px not in found][:4] + [U32_MAX]
+    dims = [0, s, s + 1, 2 * s + 1, 2 * s + 2, 3 * s + 2]  # blocks 0, 1 and 2
+    vector_compare(monkeypatch, be, smp, pixels, None, dims, f"bose {spp}, pixels {found}")
 
 
 @pytest.mark.parametrize("offset", ["cmj", "j"])
