@@ -93,9 +93,12 @@ static inline __attribute__((always_inline)) void permutation_fields_v8(uint l, 
     #pragma unroll
     for (uint i = 0u; i < l; ++i) {
         uint8 y = (((i < 8u) ? rlo : rhi) >> (4u * (i & 7u))) & 15u;
+        /* a walk continues from y in [l, w] only: all in one word of fields
+         * (w <= 7: rlo; else w = 15 and l > 8: rhi) */
+        uint8 rout = (l > 8u) ? rhi : rlo;
         #pragma unroll
         for (uint st = 0u; st + l < w + 1u; ++st)
-            y = (y < l) ? y : field4_v8(rlo, rhi, y);
+            y = (y < l) ? y : (rout >> ((y & 7u) * 4u)) & 15u;
         y += sh;
         y = (y >= l) ? y - l : y;
         y = ((p != 0u) ? y : (uint8)i) << (4u * (i & 7u));
