@@ -59,12 +59,18 @@ quoted (``peers.py``; ``--no-peers`` turns them off):
   65,536-pixel time is extrapolated from it.
 - Mitsuba 3's samplers ``orthogonal``, ``independent``, ``multijitter`` and
   ``ldsampler`` on the ``llvm_ad_rgb`` variant, if ``mitsuba`` is
-  importable, each in its own subprocess (an LLVM abort must not take the
-  benchmark down): ``seed(seed, wavefront_size=P * spp)`` after
+  importable, all in one subprocess that stays up (an LLVM abort must not
+  take the benchmark down): ``seed(seed, wavefront_size=P * spp)`` after
   ``set_samples_per_wavefront(spp)`` (as Mitsuba's render loop does), then
   ten ``next_1d()`` draws, ``dr.eval`` and ``np.asarray``; one warm-up (JIT
   compilation), then the median of ``--repeats`` runs; values/s =
   P x spp x 10 / median. P is ``--peer-pixels`` (default: ``--pixels``).
+  The runs go in rounds: each round times pyoa's OpenCL row of the required
+  case once, in this process, then each Mitsuba sampler once, and the
+  "pyoa OpenCL / peer" ratio is the median of the per-round ratios. The
+  machine's speed drifts 15-40 % over a run; a ratio of two medians taken
+  minutes apart (pyoa's rows, then the peers) carried that drift: 0.87x and
+  1.12x against ``ldsampler`` in two runs of the same code.
 
 A peer that cannot run is listed as ``skipped`` (not installed, or SciPy
 rejects the configuration) or ``failed`` (the subprocess's exit status and
@@ -137,6 +143,7 @@ import sys
 import time
 import warnings
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -430,6 +437,16 @@ def _ratio(a: float | None, b: float | None) -> str:
     return f"{r:,.0f}x" if r >= 100 else f"{r:.1f}x" if r >= 1 else f"{r:.2f}x"
 
 
+def _peer_ratio(p: dict, pyoa_rate: float | None) -> str:
+    """pyoa's OpenCL rate over the peer's: the median of the per-round ratios
+    where the peer was timed in rounds with pyoa (marked r), else the ratio
+    of the two medians."""
+    per_round = p["details"].get("pyoa_over_peer")
+    if per_round:
+        return _ratio(per_round, 1.0) + " r"
+    return _ratio(pyoa_rate, p["values_per_s"])
+
+
 def _peer_details(p: dict) -> str:
     d = p["details"]
     if p["status"] != "ok":
@@ -460,11 +477,14 @@ def peers_markdown(report: dict) -> list[str]:
     runs = f"{cfg['repeats']} run{'s' if cfg['repeats'] != 1 else ''}"
     lines += [
         f"The `{REQUIRED_CASE}` workload ({spec['spp']} points per pixel, {spec['dims']} dimensions) by other "
-        f"implementations, timed in this process after pyoa's rows. Ratios divide pyoa's median M values/s "
-        f"from the table above by the peer's. SciPy: as many `.random({spec['spp']})` calls (one pixel each) "
-        f"as fit in {cfg['peer_budget_s']:g} s after one warm-up call. The est. s column is the time the "
+        f"implementations, timed after pyoa's rows (SciPy in this process, Mitsuba in one subprocess). SciPy's "
+        f"ratios divide pyoa's median M values/s from the table above by the peer's. SciPy: as many "
+        f"`.random({spec['spp']})` calls (one pixel each) as fit in {cfg['peer_budget_s']:g} s after one warm-up call. The est. s column is the time the "
         f"full workload ({FULL_PIXELS:,} pixels x {spec['spp']} x {spec['dims']}) would take at the peer's rate. "
-        f"Mitsuba: {cfg['peer_pixels']:,} pixels in one wavefront per run, median of {runs} after a warm-up.",
+        f"Mitsuba: {cfg['peer_pixels']:,} pixels in one wavefront per run, median of {runs} after a warm-up, "
+        f"in rounds that each time pyoa's OpenCL row once, then each Mitsuba sampler once; a Mitsuba row's "
+        f"pyoa OpenCL / peer is the median of the per-round ratios (marked r), robust to the machine's drift "
+        f"between the table above and the peers.",
         "",
         f"| peer | status | M values/s | of fill | pyoa OpenCL / peer | pyoa NumPy / peer | est. s, {FULL_PIXELS:,} px | "
         "details |",
@@ -477,7 +497,7 @@ def peers_markdown(report: dict) -> list[str]:
         lines.append(
             f"| {p['name']} | {p['status']} | {_rate(rate) if rate else ''} | "
             f"{f'{rate / fill:.3f}' if rate and fill else ''} | "
-            f"{_ratio(pyoa_rate.get('opencl'), rate)} | {_ratio(pyoa_rate.get('numpy'), rate)} | "
+            f"{_peer_ratio(p, pyoa_rate.get('opencl'))} | {_ratio(pyoa_rate.get('numpy'), rate)} | "
             f"{f'{full:,.1f}' if full else ''} | {_peer_details(p)} |"
         )
     return lines
@@ -674,6 +694,26 @@ def parse_args(argv=None) -> argparse.Namespace:
     return args
 
 
+def pyoa_round(results: list[dict], args) -> Callable[[], float] | None:
+    """One timed OpenCL call of the required case, returning its values per
+    second, for the peers' rounds to alternate with (peers.mitsuba_samplers);
+    None where that row did not run."""
+    row = next((r for r in results if r["case"] == REQUIRED_CASE and r["backend"] == "opencl"), None)
+    if row is None or row["status"] != "ok":
+        return None
+    entry, smp = prepare(REQUIRED_CASE, "opencl", args.pixels, args.seed, args.fresh_output)
+    if smp is None:
+        return None
+
+    def run() -> float:
+        out = _output(entry, args.fresh_output)
+        t0 = time.perf_counter()
+        smp.generate(pixels=range(entry["pixels"]), out=out)
+        return entry["values"] / (time.perf_counter() - t0)
+
+    return run
+
+
 def main(argv=None) -> int:
     args = parse_args(argv)
     if args.list:
@@ -703,7 +743,7 @@ def main(argv=None) -> int:
         spec = CASES[REQUIRED_CASE]
         peer_results = peers.run_peers(spec["spp"], spec["dims"], pixels=args.peer_pixels,
                                        budget_s=args.peer_budget, repeats=args.repeats, seed=args.seed,
-                                       full_pixels=FULL_PIXELS, log=log)
+                                       full_pixels=FULL_PIXELS, pyoa_run=pyoa_round(results, args), log=log)
     meta["loadavg_start"], meta["loadavg_end"] = load_start, loadavg()
     # after the timing and the load average: it compiles kernels in a subprocess (a few seconds per case)
     ceilings = compute_ceilings(args.cases, results, args.seed) if args.ceiling else {}

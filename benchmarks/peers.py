@@ -5,9 +5,11 @@
   is one pixel's point set. It builds the array in Python loops, so it is
   timed for a time budget (as many calls as fit) rather than for the whole
   workload, and the full workload's time is extrapolated.
-- ``mitsuba_sampler``: one of Mitsuba 3's samplers on its LLVM backend,
-  drawing ``dims`` values for ``pixels x spp`` samples in one wavefront, in a
-  subprocess (a Dr.Jit/LLVM abort must not take the benchmark down).
+- ``mitsuba_samplers``: Mitsuba 3's samplers on its LLVM backend, each
+  drawing ``dims`` values for ``pixels x spp`` samples in one wavefront, in
+  one subprocess that stays up (``MitsubaPeers``: a Dr.Jit/LLVM abort must
+  not take the benchmark down), timed in rounds that can alternate with
+  pyoa's own timed calls.
 - ``run_json_script``: the subprocess runner, shared with
   ``bench_render.py``: runs a Python snippet with this interpreter and reads
   a JSON object from the last line of its standard output.
@@ -163,25 +165,32 @@ def scipy_lhs(n: int, d: int, *, budget_s: float, seed: int = 0, max_calls: int 
 # ---------------------------------------------------------------------------
 # Mitsuba 3
 
-#: argv: variant, sampler name, pixels, spp, dims, repeats, seed, largest wavefront. Prints one JSON line.
-_MITSUBA_SAMPLER = r"""
-import json, statistics, sys, time
+#: argv: variant, comma-separated sampler names, pixels, spp, dims, seed, largest wavefront.
+#: Loads every sampler and draws once with each (the JIT compilation), prints one JSON line
+#: (``ready`` with each sampler's facts), then times one draw per line of standard input
+#: naming a sampler, answering one JSON line each, until standard input closes.
+_MITSUBA_SERVER = r"""
+import json, sys, time
 import numpy as np
 import mitsuba as mi
 import drjit as dr
-variant, name = sys.argv[1:3]
-pixels, spp, dims, repeats, seed, max_wavefront = map(int, sys.argv[3:9])
+variant, names = sys.argv[1], sys.argv[2].split(",")
+pixels, spp, dims, seed, max_wavefront = map(int, sys.argv[3:8])
 mi.set_variant(variant)
-sampler = mi.load_dict({"type": name, "sample_count": spp})
-spp_used = int(sampler.sample_count())  # ldsampler rounds up to a power-of-two square
-used_pixels = min(pixels, max_wavefront // spp_used)
-wavefront = used_pixels * spp_used
-# As Mitsuba's own render loop does: all of a pixel's samples in one wavefront, so sample
-# indices 0..spp-1 of one sequence per pixel (without it every lane is sample 0 of its own sequence).
-if hasattr(sampler, "set_samples_per_wavefront"):
-    sampler.set_samples_per_wavefront(spp_used)
+samplers, facts = {}, {}
+for name in names:
+    sampler = mi.load_dict({"type": name, "sample_count": spp})
+    spp_used = int(sampler.sample_count())  # ldsampler rounds up to a power-of-two square
+    used_pixels = min(pixels, max_wavefront // spp_used)
+    # As Mitsuba's own render loop does: all of a pixel's samples in one wavefront, so sample
+    # indices 0..spp-1 of one sequence per pixel (without it every lane is sample 0 of its own sequence).
+    if hasattr(sampler, "set_samples_per_wavefront"):
+        sampler.set_samples_per_wavefront(spp_used)
+    samplers[name] = (sampler, used_pixels * spp_used)
+    facts[name] = {"sample_count": spp_used, "pixels": used_pixels, "wavefront_size": used_pixels * spp_used}
 
-def draw():
+def draw(name):
+    sampler, wavefront = samplers[name]
     t0 = time.perf_counter()
     sampler.seed(seed, wavefront)
     vals = [sampler.next_1d() for _ in range(dims)]
@@ -191,15 +200,84 @@ def draw():
     assert all(a.shape == (wavefront,) for a in arrs), [a.shape for a in arrs]
     return dt
 
-warmup = draw()
-times = [draw() for _ in range(repeats)]
-med = statistics.median(times)
-print(json.dumps({"status": "ok", "version": mi.__version__, "drjit": dr.__version__,
-                  "variant": mi.variant(), "sample_count": spp_used, "pixels": used_pixels,
-                  "wavefront_size": wavefront, "dims": dims, "warmup_s": warmup, "times_s": times,
-                  "median_s": med, "min_s": min(times), "max_s": max(times),
-                  "values_per_s": wavefront * dims / med}))
+for name in names:
+    facts[name]["warmup_s"] = draw(name)
+print(json.dumps({"status": "ready", "version": mi.__version__, "drjit": dr.__version__,
+                  "variant": mi.variant(), "dims": dims, "samplers": facts}), flush=True)
+for line in sys.stdin:
+    print(json.dumps({"s": draw(line.strip())}), flush=True)
 """
+
+
+class MitsubaPeers:
+    """Mitsuba 3's samplers ``names`` (LLVM backend) in one subprocess that
+    stays up between draws, so that their timed runs can alternate with
+    pyoa's (a Dr.Jit/LLVM abort must not take the benchmark down, and
+    Mitsuba's thread pool stays out of this process). A draw is
+    ``seed(seed, wavefront_size=pixels*spp)`` then ``dims`` times
+    ``next_1d()``, evaluated; every sampler draws once when the process
+    starts (JIT compilation). Use as a context manager; :meth:`draw` raises
+    ``RuntimeError`` when the process fails or takes longer than ``timeout``
+    seconds for one answer."""
+
+    def __init__(self, names, pixels: int, spp: int, dims: int, *, seed: int = 0,
+                 timeout: float = MITSUBA_TIMEOUT_S):
+        self.names, self.timeout = tuple(names), timeout
+        argv = [MITSUBA_VARIANT, ",".join(self.names), pixels, spp, dims, seed, MAX_WAVEFRONT]
+        self._proc = subprocess.Popen([sys.executable, "-c", _MITSUBA_SERVER, *map(str, argv)],
+                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                      text=True, env=mitsuba_env())
+        self.facts = self._answer()  # status "ready", versions, each sampler's spp, pixels and warm-up
+
+    def __enter__(self) -> "MitsubaPeers":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self._proc.poll() is None:
+            self._proc.stdin.close()
+            try:
+                self._proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                self._proc.kill()
+                self._proc.wait()
+
+    def draw(self, name: str) -> float:
+        """Seconds of one timed draw of sampler ``name``."""
+        self._proc.stdin.write(name + "\n")
+        self._proc.stdin.flush()
+        return float(self._answer()["s"])
+
+    def _answer(self) -> dict:
+        """The next JSON line of the subprocess's output (Mitsuba's logger
+        leaves terminal colour codes, ESC [ ... m, on stdout)."""
+        import selectors
+
+        sel = selectors.DefaultSelector()
+        sel.register(self._proc.stdout, selectors.EVENT_READ)
+        deadline = time.monotonic() + self.timeout
+        try:
+            while True:
+                left = deadline - time.monotonic()
+                if left <= 0 or not sel.select(timeout=left):
+                    self._proc.kill()
+                    raise RuntimeError(f"Mitsuba gave no answer in {self.timeout:g} s")
+                line = self._proc.stdout.readline()
+                if not line:  # the process ended
+                    self._proc.wait()
+                    err = self._proc.stderr.read().strip().splitlines()
+                    raise RuntimeError(f"Mitsuba's process ended (exit status {self._proc.returncode}): "
+                                       + (err[-1] if err else "no message")[:300])
+                try:
+                    out = json.loads(_ANSI.sub("", line).strip())
+                except json.JSONDecodeError:
+                    continue
+                if isinstance(out, dict):
+                    return out
+        finally:
+            sel.close()
 
 
 def mitsuba_env() -> dict:
@@ -214,43 +292,70 @@ def mitsuba_env() -> dict:
     return env
 
 
-def mitsuba_sampler(name: str, pixels: int, spp: int, dims: int, *, repeats: int, seed: int = 0,
-                    timeout: float = MITSUBA_TIMEOUT_S, full_pixels: int | None = None) -> dict:
-    """Mitsuba 3 sampler ``name`` (LLVM backend): ``seed(seed, wavefront_size=pixels*spp)`` then
-    ``dims`` times ``next_1d()``, evaluated; one warm-up (JIT compilation), then the median of
-    ``repeats`` runs; ``values_per_s = wavefront * dims / median``. In a subprocess."""
-    label = f"mitsuba {name}"
+def mitsuba_samplers(names, pixels: int, spp: int, dims: int, *, repeats: int, seed: int = 0,
+                     full_pixels: int | None = None, pyoa_run: Callable[[], float] | None = None,
+                     log: Callable[[str], None] = print) -> list[dict]:
+    """Mitsuba 3's samplers ``names`` (:class:`MitsubaPeers`), ``repeats``
+    rounds of one timed draw each; ``values_per_s = wavefront * dims /
+    median``. With ``pyoa_run`` (one timed pyoa call, returning its values
+    per second), each round starts with it, and each sampler's details hold
+    pyoa's rates of those rounds (``pyoa_values_per_s``) and the median of
+    the per-round ratios pyoa / sampler (``pyoa_over_peer``): the machine's
+    speed drifts 15-40 % over a run, and a ratio of two medians taken
+    minutes apart carries that drift, a ratio within one round far less."""
+    labels = {name: f"mitsuba {name}" for name in names}
     if not mitsuba_available():
-        return _entry(label, "skipped", reason="mitsuba is not installed")
-    argv = [MITSUBA_VARIANT, name, pixels, spp, dims, repeats, seed, MAX_WAVEFRONT]
-    res = run_json_script(_MITSUBA_SAMPLER, argv, timeout=timeout, env=mitsuba_env())
-    if res.get("status") != "ok":
-        return _entry(label, "failed", details={"variant": MITSUBA_VARIANT, "libllvm": drjit_llvm()},
-                      reason=res.get("reason") or f"unexpected result: {res!r}"[:300])
-    rate = res.pop("values_per_s")
-    res.pop("status")
-    res["libllvm"] = drjit_llvm()
-    res["requested_pixels"], res["requested_spp"] = pixels, spp
-    if full_pixels:
-        res["full_pixels"] = full_pixels
-        res["full_workload_s"] = full_pixels * spp * dims / rate  # the requested workload at this rate
-    return _entry(label, "ok", values_per_s=rate, details=res)
+        return [_entry(labels[n], "skipped", reason="mitsuba is not installed") for n in names]
+    try:
+        with MitsubaPeers(names, pixels, spp, dims, seed=seed) as mts:
+            times = {n: [] for n in names}
+            pyoa_rates = []
+            for k in range(repeats):
+                if pyoa_run is not None:
+                    pyoa_rates.append(pyoa_run())
+                for n in names:
+                    times[n].append(mts.draw(n))
+                log(f"peers: round {k + 1}/{repeats}: "
+                    + (f"pyoa {pyoa_rates[-1] / 1e6:.0f}, " if pyoa_run is not None else "")
+                    + ", ".join(f"{n} {t:.3f} s" for n, t in ((n, times[n][-1]) for n in names)))
+            facts = mts.facts
+    except (RuntimeError, OSError) as exc:
+        return [_entry(labels[n], "failed", details={"variant": MITSUBA_VARIANT, "libllvm": drjit_llvm()},
+                       reason=str(exc)[:300]) for n in names]
+    out = []
+    for n in names:
+        d = {k: facts[k] for k in ("version", "drjit", "variant", "dims")} | facts["samplers"][n]
+        med = statistics.median(times[n])
+        values = d["wavefront_size"] * dims
+        d.update(times_s=times[n], median_s=med, min_s=min(times[n]), max_s=max(times[n]),
+                 libllvm=drjit_llvm(), requested_pixels=pixels, requested_spp=spp)
+        rate = values / med
+        if pyoa_run is not None:
+            d["pyoa_values_per_s"] = pyoa_rates
+            d["pyoa_over_peer"] = statistics.median(p * t / values for p, t in zip(pyoa_rates, times[n]))
+        if full_pixels:
+            d["full_pixels"] = full_pixels
+            d["full_workload_s"] = full_pixels * spp * dims / rate  # the requested workload at this rate
+        out.append(_entry(labels[n], "ok", values_per_s=rate, details=d))
+    return out
 
 
 # ---------------------------------------------------------------------------
 
 
 def run_peers(spp: int, dims: int, *, pixels: int, budget_s: float, repeats: int, seed: int = 0,
-              full_pixels: int | None = None, log: Callable[[str], None] = print) -> list[dict]:
-    """SciPy's OA-LHS, then each Mitsuba sampler, one after the other; never raises."""
+              full_pixels: int | None = None, pyoa_run: Callable[[], float] | None = None,
+              log: Callable[[str], None] = print) -> list[dict]:
+    """SciPy's OA-LHS, then Mitsuba's samplers in rounds (interleaved with
+    ``pyoa_run`` where given: :func:`mitsuba_samplers`); never raises."""
     out = []
     log(f"peers: scipy LatinHypercube(strength=2), N={spp}, d={dims}, budget {budget_s:g} s")
     out.append(scipy_lhs(spp, dims, budget_s=budget_s, seed=seed, max_calls=pixels, full_pixels=full_pixels))
-    for name in MITSUBA_SAMPLERS:
-        if mitsuba_available():
-            log(f"peers: mitsuba {name} ({MITSUBA_VARIANT}), {pixels:,} pixels x {spp} spp x {dims} dims, "
-                f"warm-up + {repeats} runs")
-        out.append(mitsuba_sampler(name, pixels, spp, dims, repeats=repeats, seed=seed, full_pixels=full_pixels))
+    if mitsuba_available():
+        log(f"peers: mitsuba {', '.join(MITSUBA_SAMPLERS)} ({MITSUBA_VARIANT}), {pixels:,} pixels x {spp} spp x "
+            f"{dims} dims, warm-up + {repeats} rounds" + (", each after one pyoa call" if pyoa_run else ""))
+    out += mitsuba_samplers(MITSUBA_SAMPLERS, pixels, spp, dims, repeats=repeats, seed=seed,
+                            full_pixels=full_pixels, pyoa_run=pyoa_run, log=log)
     for p in out:
         if p["status"] == "ok":
             log(f"  {p['name']:<34} {p['values_per_s'] / 1e6:12.3f} M values/s")
