@@ -274,12 +274,13 @@ static inline __attribute__((always_inline)) void permute_walks(ushort16 *x, uin
             x[c] = (x[c] < n) ? x[c] : permute_round16_v16(x[c], p, w);
     }
 #endif
-    const ushort sh = (ushort)(p % VN);
+    /* (x + p % N) mod N without leaving 16 bits: x + sh reaches 2 N - 2,
+     * past 65535 for N > 32768, so the lanes at or above N - sh subtract
+     * N - sh instead of adding sh */
+    const ushort sh = (ushort)(p % VN), back = (ushort)(VN - p % VN);
     #pragma unroll
-    for (uint c = 0u; c < WALK_VECTORS; ++c) {
-        x[c] += sh;
-        x[c] = (x[c] >= n) ? x[c] - n : x[c];
-    }
+    for (uint c = 0u; c < WALK_VECTORS; ++c)
+        x[c] = (x[c] >= back) ? x[c] - back : x[c] + sh;
 }
 
 /* The rows of a later block (docs/spec.md section 6: block_row, two

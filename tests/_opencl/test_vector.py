@@ -353,6 +353,25 @@ def test_vector_rows_walks_where_round_values_leave_the_range(monkeypatch, backe
     vector_compare(monkeypatch, be, smp, pixels, None, dims, f"bose {spp}, pixels {found}")
 
 
+@pytest.mark.parametrize("name, spp, strength, offset, dims", [
+    ("cmjnd", 3**10, 10, "centered", [0, 9, 10, 11, 34]),  # N = 59049, blocks of 10
+    ("cmjnd", 6**6, 6, "centered", [0, 5, 6, 13, 20]),  # N = 46656, blocks of 6
+])
+def test_vector_rows_of_the_largest_arrays(monkeypatch, backends, name, spp, strength, offset, dims):
+    """vector_rows walks in 16-bit lanes up to N = 65535 (vector.MAX_ROWS16).
+    Its final shift, (x + p % N) mod N, would pass 65535 for N > 32768 if
+    it added first (it did, and every later-block value of such arrays
+    whose shift wrapped came out wrong); the largest sample indices and
+    several seeds reach it."""
+    from pyoa._opencl import vector
+
+    be = backends["vector"]
+    smp = make(name, spp, max(dims) + 1, strength=strength, seed=U32_MAX, offset=offset, backend="numpy")
+    samples = [*range(spp - 40, spp), 0, 1, 32767, 32768]
+    req = vector_compare(monkeypatch, be, smp, [0, 1, 2, 77, U32_MAX], samples, dims, f"{name} N={spp}")
+    assert vector.shape(req, whole_rect(req)).later
+
+
 @pytest.mark.parametrize("offset", ["cmj", "j"])
 @pytest.mark.parametrize("spp", [64 * 64, 127 * 127])
 def test_vector_path_long_sample_axis(monkeypatch, backends, spp, offset):
