@@ -2,48 +2,12 @@
  * the mathematics and references). Values of random, sobol02, halton and
  * sobol are k * 2^-24 with k a 24-bit integer: exact in float, no rounding. */
 
-/* The *_KEY constants (RANDOM_KEY, PAD_KEY, HALTON_KEY, DIGIT_KEY, SOBOL_KEY,
- * OWEN_KEY, SHUFFLE_KEY, SUBX_KEY, SUBY_KEY, JITX_KEY, JITY_KEY) are not
- * defined here: pyoa/_opencl/program.py's defines() passes them as -D build
- * options (uint literals), generated from the constants of the same names in
- * pyoa/reference/baselines.py, their only definition. */
-#ifndef RANDOM_KEY
-#error "RANDOM_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef PAD_KEY
-#error "PAD_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef HALTON_KEY
-#error "HALTON_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef DIGIT_KEY
-#error "DIGIT_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef SOBOL_KEY
-#error "SOBOL_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef OWEN_KEY
-#error "OWEN_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef SHUFFLE_KEY
-#error "SHUFFLE_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef SUBX_KEY
-#error "SUBX_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef SUBY_KEY
-#error "SUBY_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef JITX_KEY
-#error "JITX_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef JITY_KEY
-#error "JITY_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
+/* The PYOA_*_KEY constants come from pyoa/keys.h (kernels/include), generated
+ * from the constants of pyoa/reference/baselines.py, their only definition. */
 
 float unit24(uint h) { return convert_float(h >> 8) * 0x1.0p-24f; }
 
-uint derived_seed(uint p, uint index, uint key) { return p ? hash_pair(p, index, key) : 0u; }
+uint derived_seed(uint p, uint index, uint key) { return p ? pyoa_hash_pair(p, index, key) : 0u; }
 
 uint reverse_bits(uint x)
 {
@@ -84,51 +48,51 @@ uint sobol_bits(uint g, __global const uint *v)
 
 float sample_random(uint i, uint j, uint p)
 {
-    return unit24(mix32(i ^ hash_pair(p, j, RANDOM_KEY)));
+    return unit24(pyoa_mix32(i ^ pyoa_hash_pair(p, j, PYOA_RANDOM_KEY)));
 }
 
 float sample_jittered2d(uint i, uint j, uint m, uint dims, uint p, float J)
 {
-    uint q = derived_seed(p, j >> 1, PAD_KEY);
+    uint q = derived_seed(p, j >> 1, PYOA_PAD_KEY);
     uint N = m * m;
-    uint k = permute(i, N, q * SHUFFLE_KEY);
+    uint k = pyoa_permute(i, N, q * PYOA_SHUFFLE_KEY);
     bool even = (j & 1u) == 0u;
-    float jit = jitter_value(randfloat(k, q * (even ? JITX_KEY : JITY_KEY)), J);
-    if (even && j + 1u == dims) return sample_value(k, 0u, jit, 1u, N);  /* a lone last dimension */
-    return sample_value(even ? k % m : k / m, 0u, jit, 1u, m);
+    float jit = pyoa_jitter_value(pyoa_randfloat(k, q * (even ? PYOA_JITX_KEY : PYOA_JITY_KEY)), J);
+    if (even && j + 1u == dims) return pyoa_sample_value(k, 0u, jit, 1u, N);  /* a lone last dimension */
+    return pyoa_sample_value(even ? k % m : k / m, 0u, jit, 1u, m);
 }
 
 float sample_cmj2d(uint i, uint j, uint m, uint n, uint p, float J)
 {
-    uint q = derived_seed(p, j >> 1, PAD_KEY);
-    uint k = permute(i, m * n, q * SHUFFLE_KEY);
-    uint sx = permute(k % m, m, q * SUBX_KEY);
+    uint q = derived_seed(p, j >> 1, PYOA_PAD_KEY);
+    uint k = pyoa_permute(i, m * n, q * PYOA_SHUFFLE_KEY);
+    uint sx = pyoa_permute(k % m, m, q * PYOA_SUBX_KEY);
     if ((j & 1u) == 0u) {
-        uint sy = permute(k / m, n, q * SUBY_KEY);
-        return sample_value(k % m, sy, jitter_value(randfloat(k, q * JITX_KEY), J), n, m);
+        uint sy = pyoa_permute(k / m, n, q * PYOA_SUBY_KEY);
+        return pyoa_sample_value(k % m, sy, pyoa_jitter_value(pyoa_randfloat(k, q * PYOA_JITX_KEY), J), n, m);
     }
-    return sample_value(k / m, sx, jitter_value(randfloat(k, q * JITY_KEY), J), m, n);
+    return pyoa_sample_value(k / m, sx, pyoa_jitter_value(pyoa_randfloat(k, q * PYOA_JITY_KEY), J), m, n);
 }
 
 float sample_sobol02(uint i, uint j, uint log2n, uint p, __global const uint *directions)
 {
-    uint q = derived_seed(p, j >> 1, PAD_KEY);
+    uint q = derived_seed(p, j >> 1, PYOA_PAD_KEY);
     /* hashed scramble seeds: Burley's top levels depend on a seed's low bits only */
-    uint g = owen_scramble(i, derived_seed(q, 0u, OWEN_KEY)) & ((1u << log2n) - 1u);
+    uint g = owen_scramble(i, derived_seed(q, 0u, PYOA_OWEN_KEY)) & ((1u << log2n) - 1u);
     uint c = j & 1u;
-    return unit24(owen_scramble(sobol_bits(g, directions + 32u * c), derived_seed(q, 1u + c, OWEN_KEY)));
+    return unit24(owen_scramble(sobol_bits(g, directions + 32u * c), derived_seed(q, 1u + c, PYOA_OWEN_KEY)));
 }
 
 float sample_halton(uint i, uint j, uint p, __global const uint *primes)
 {
     uint b = primes[j];
-    uint q = derived_seed(p, j, HALTON_KEY);
+    uint q = derived_seed(p, j, PYOA_HALTON_KEY);
     uint rest = i, prefix = 0u;
     ulong numer = 0ul, power = 1ul;  /* power = b^(k-1) */
     while (power < 0x1000000ul) {
         uint d = rest % b;
         rest /= b;
-        uint dd = q ? permute(d, b, hash_pair(q, (uint)power + prefix, DIGIT_KEY)) : d;
+        uint dd = q ? pyoa_permute(d, b, pyoa_hash_pair(q, (uint)power + prefix, PYOA_DIGIT_KEY)) : d;
         numer = numer * b + dd;
         prefix += d * (uint)power;
         power *= b;
@@ -139,5 +103,5 @@ float sample_halton(uint i, uint j, uint p, __global const uint *primes)
 float sample_sobol(uint i, uint j, uint p, __global const uint *directions)
 {
     uint x = sobol_bits(i ^ (i >> 1), directions + 32u * j);
-    return unit24(owen_scramble(x, derived_seed(p, j, SOBOL_KEY)));
+    return unit24(owen_scramble(x, derived_seed(p, j, PYOA_SOBOL_KEY)));
 }

@@ -3,17 +3,8 @@
  * references and the float rule are there; this is the same computation,
  * operation for operation). */
 
-/* FAURE_KEY and FAURE_DIGIT_KEY come from pyoa/reference/faure.py, their only
- * definition, as -D build options (pyoa._opencl.program.defines()). */
-#ifndef FAURE_KEY
-#error "FAURE_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef FAURE_DIGIT_KEY
-#error "FAURE_DIGIT_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef FAURE_INDEX_KEY
-#error "FAURE_INDEX_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
+/* PYOA_FAURE_KEY and PYOA_FAURE_DIGIT_KEY come from pyoa/keys.h, generated from
+ * pyoa/reference/faure.py, their only definition. */
 
 /* Most digits K (b^K >= 2^24): 24, in base 2. */
 #define FAURE_MAX_DIGITS 24
@@ -33,8 +24,8 @@ static inline uint faure_digits(uint b)
 float sample_faure(uint i, uint j, uint b, uint n, uint p)
 {
     uint col = j % b, block = j / b;
-    uint P = block_seed(p, block);
-    uint q = derived_seed(P, col, FAURE_KEY);
+    uint P = pyoa_block_seed(p, block);
+    uint q = derived_seed(P, col, PYOA_FAURE_KEY);
     uint a[FAURE_MAX_DIGITS];
     if (block)  /* a copy: all K digits of its nested-scrambled index */
         n = faure_digits(b);
@@ -46,10 +37,10 @@ float sample_faure(uint i, uint j, uint b, uint n, uint p)
     if (block) {
         /* every copy past the first reads the sequence in its own nested
          * order: digit r permuted by a hash of the digits above it */
-        uint s = hash_pair(P, b, FAURE_INDEX_KEY), high = 0u, power = 1u;
+        uint s = pyoa_hash_pair(P, b, PYOA_FAURE_INDEX_KEY), high = 0u, power = 1u;
         for (uint r = n; r-- > 0u;) {
             uint d = a[r];
-            a[r] = permute(d, b, hash_pair(s, power + high, FAURE_DIGIT_KEY));
+            a[r] = pyoa_permute(d, b, pyoa_hash_pair(s, power + high, PYOA_FAURE_DIGIT_KEY));
             high = high * b + d;
             power *= b;
         }
@@ -64,7 +55,7 @@ float sample_faure(uint i, uint j, uint b, uint n, uint p)
     uint prefix = 0u;                /* (y_0 ... y_{k-1}) in base b */
     for (uint k = 0u; power < 0x1000000ul; k++) {
         uint y = k < n ? a[k] : 0u;
-        uint yy = q ? permute(y, b, hash_pair(q, (uint)power + prefix, FAURE_DIGIT_KEY)) : y;
+        uint yy = q ? pyoa_permute(y, b, pyoa_hash_pair(q, (uint)power + prefix, PYOA_FAURE_DIGIT_KEY)) : y;
         numer = numer * b + yy;
         prefix = prefix * b + y;
         power *= b;

@@ -46,7 +46,7 @@ uint rect_index(uint out0, uint k, uint pl, uint d, uint n_k, uint n_dims)
     uint k = (uint)get_global_id(0), pd = (uint)get_global_id(1);                       \
     uint d = pd % n_dims, pl = pd / n_dims;                                             \
     uint i = samples[k], j = dims[d], pixel = pixels[pl];                               \
-    uint p = pixel_seed(seed, pixel)
+    uint p = pyoa_pixel_seed(seed, pixel)
 
 /* The value of construction `construction` (its CONSTRUCTION_* code) with B
  * columns per block, N rows and M sub-strata: generated from the catalogue
@@ -90,12 +90,12 @@ __kernel void generate(RECT_ARGS,
  * the axis is whole 8-lane vectors (PoCL runs a remainder scalar; with E = 23
  * the 7 scalar lanes cost more than the 16 vector ones). The padding entries
  * are written with 0 and never read. keys holds
- * per pd the column key q and the final shifts q * STRATUM_KEY % s and
- * q * SUBSTRATUM_KEY % M (pyoa._numpy.oa.table_keys): computed on the host,
+ * per pd the column key q and the final shifts q * PYOA_STRATUM_KEY % s and
+ * q * PYOA_SUBSTRATUM_KEY % M (pyoa._numpy.oa.table_keys): computed on the host,
  * they cost PoCL more here than the cycle walks themselves, even as loop
  * invariants (docs/performance.md).
  *
- * permute(i, l, p) = (walk(i) + p % l) % l with walk(i) < l, so the last %
+ * pyoa_permute(i, l, p) = (walk(i) + p % l) % l with walk(i) < l, so the last %
  * is a subtraction. A loop keeps PoCL from vectorizing a kernel, so the walk
  * runs in two launches: `tables` takes 3 rounds for every entry
  * (straight-line, 8 lanes wide), which ends the walk of most entries, and
@@ -106,7 +106,7 @@ __kernel void generate(RECT_ARGS,
 
 __attribute__((always_inline)) uint walk_step(uint x, uint l, uint p, uint w)
 {
-    uint y = permute_round(x, p, w);
+    uint y = pyoa_permute_round(x, p, w);
     return (x < l) ? x : y;
 }
 
@@ -119,17 +119,17 @@ __kernel void tables(__global uint *restrict tab,
 {
     uint e = (uint)get_global_id(0), pd = (uint)get_global_id(1);
     uint q = keys[3u * pd], cS = keys[3u * pd + 1u], cU = keys[3u * pd + 2u];
-    uint wS = walk_mask(s), wU = walk_mask(M);
+    uint wS = pyoa_walk_mask(s), wU = pyoa_walk_mask(M);
     uint stratum = e < s;
-    uint l = stratum ? s : M, p = q * (stratum ? STRATUM_KEY : SUBSTRATUM_KEY), c = stratum ? cS : cU;
+    uint l = stratum ? s : M, p = q * (stratum ? PYOA_STRATUM_KEY : PYOA_SUBSTRATUM_KEY), c = stratum ? cS : cU;
     uint w = stratum ? wS : wU;
     uint i = stratum ? e : (e + 1u >= E) ? 0u : e - s;
     /* 3 rounds, written out: a loop, even of constant trip count, is still
      * there when PoCL builds its work-item loop */
-    uint x = walk_step(walk_step(permute_round(i, p, w), l, p, w), l, p, w);
+    uint x = walk_step(walk_step(pyoa_permute_round(i, p, w), l, p, w), l, p, w);
     uint v = x + c;
     v = (x >= l) ? (x | WALK_PENDING) : (v >= l) ? v - l : v;
-    tab[pd * Es + e] = (e + 1u == E) ? q * JITTER_KEY : (e >= E) ? 0u : p ? v : i;
+    tab[pd * Es + e] = (e + 1u == E) ? q * PYOA_JITTER_KEY : (e >= E) ? 0u : p ? v : i;
 }
 
 /* Finishes the walks `tables` left pending (same launch shape). Entries
@@ -147,8 +147,8 @@ __kernel void tables_finish(__global uint *restrict tab,
     if (!(v & WALK_PENDING) || e + 1u >= E) return;
     uint q = keys[3u * pd];
     uint stratum = e < s;
-    uint l = stratum ? s : M, p = q * (stratum ? STRATUM_KEY : SUBSTRATUM_KEY);
-    uint x = permute_walk(v & ~WALK_PENDING, l, p, walk_mask(l)) + keys[3u * pd + (stratum ? 1u : 2u)];
+    uint l = stratum ? s : M, p = q * (stratum ? PYOA_STRATUM_KEY : PYOA_SUBSTRATUM_KEY);
+    uint x = pyoa_permute_walk(v & ~WALK_PENDING, l, p, pyoa_walk_mask(l)) + keys[3u * pd + (stratum ? 1u : 2u)];
     tab[g] = (x >= l) ? x - l : x;
 }
 
@@ -191,14 +191,14 @@ __kernel void NAME(__global float *restrict out,                                
     uint d = pd % n_dims, pl = pd / n_dims, base = pd * Es;                             \
     LOCATE                                                                              \
     uint stratum = tab[base + cell_a[c]];                                               \
-    float jit = jitter_value(randfloat(row, tab[base + E - 1u]), J);                    \
+    float jit = pyoa_jitter_value(pyoa_randfloat(row, tab[base + E - 1u]), J);                    \
     out[rect_index(out0, k, pl, d, n_k, n_dims)] = VALUE;                               \
 }
 
 #define CELLS_BY_SAMPLE uint c = d * n_k + k, row = isamp[k];
 #define CELLS_BY_ROW uint row = rows[ro[pd] + k], c = d * N + row;
-#define CMJ_VALUE sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s)
-#define CENTERED_VALUE centered_value(stratum, jit, M, s)
+#define CMJ_VALUE pyoa_sample_value(stratum, tab[base + s + cell_u[c]], jit, M, s)
+#define CENTERED_VALUE pyoa_centered_value(stratum, jit, M, s)
 
 /* One kernel per offset of the table path rather than one with an offset
  * argument: a select between the two value paths, even on that uniform
@@ -221,7 +221,7 @@ __kernel void block_rows(__global uint *restrict rows,
                          const uint N)
 {
     uint k = (uint)get_global_id(0), m = (uint)get_global_id(1) + 1u;
-    rows[m * n_k + k] = block_row(rows[k], N, orders[m - 1u]);
+    rows[m * n_k + k] = pyoa_block_row(rows[k], N, orders[m - 1u]);
 }
 
 /* The comparison samplers: one kernel each, one work-item per value, over a

@@ -8,15 +8,15 @@
  * (pyoa._opencl.program.dispatch_source), puts the three together. */
 
 /* The block rule (docs/spec.md section 6): dimension j of sample i reads
- * column j % B of copy j / B, with seed P = block_seed(p, j / B), at row
- * block_row(i, N, block_order_seed(P, j / B, N)): row i in block 0, the
+ * column j % B of copy j / B, with seed P = pyoa_block_seed(p, j / B), at row
+ * pyoa_block_row(i, N, pyoa_block_order_seed(P, j / B, N)): row i in block 0, the
  * copy's own order of the rows in later blocks. */
 void oa_locate(uint p, uint i, uint j, uint B, uint N, uint *P, uint *row, uint *col)
 {
     uint block = j / B;
     *col = j % B;
-    *P = block_seed(p, block);
-    *row = block_row(i, N, block_order_seed(*P, block, N));
+    *P = pyoa_block_seed(p, block);
+    *row = pyoa_block_row(i, N, pyoa_block_order_seed(*P, block, N));
 }
 
 /* Bose over GF(s): A_ij of column j (< s+1) and A_ik of its partner column
@@ -59,8 +59,8 @@ void cmjnd_cell(uint i, uint s, uint sj, uint *aij, uint *v)
  * jitter's randfloat index). */
 float oa_value(uint i, uint stratum, uint sub, uint P3, uint M, uint s, float J, uint offset)
 {
-    float jit = jitter_value(randfloat(i, P3), J);
-    return (offset == OFFSET_CENTERED) ? centered_value(stratum, jit, M, s) : sample_value(stratum, sub, jit, M, s);
+    float jit = pyoa_jitter_value(pyoa_randfloat(i, P3), J);
+    return (offset == OFFSET_CENTERED) ? pyoa_centered_value(stratum, jit, M, s) : pyoa_sample_value(stratum, sub, jit, M, s);
 }
 
 /* sub-stratum of the offset styles that hash per cell ('j', 'mj') or per
@@ -70,7 +70,7 @@ uint offset_sub(uint offset, uint u, uint M, uint cell_key, uint aij, uint P2)
 {
     if (offset == OFFSET_CENTERED) return 0u;  /* skip the cycle walk it would discard */
     uint seed = (offset == OFFSET_J) ? cell_key * P2 : (offset == OFFSET_MJ) ? (aij + 1u) * P2 : P2;
-    return permute(u, M, seed);
+    return pyoa_permute(u, M, seed);
 }
 
 /* pow_u(s, e) = s^e; every use stays below 2^24. */
@@ -118,7 +118,7 @@ void bose_bush_cell(uint i, uint j, uint s, __global const ushort *gf, uint tabl
 float oa_tail(uint row, uint col, uint P, uint aij, uint u, uint cell_key, uint s, uint M, uint offset, float J)
 {
     uint q = P * (col + 1u);  /* times the three keys: the column's seeds (section 3.3) */
-    uint stratum = permute(aij, s, q * STRATUM_KEY);
-    uint sub = offset_sub(offset, u, M, cell_key, aij, q * SUBSTRATUM_KEY);
-    return oa_value(row, stratum, sub, q * JITTER_KEY, M, s, J, offset);
+    uint stratum = pyoa_permute(aij, s, q * PYOA_STRATUM_KEY);
+    uint sub = offset_sub(offset, u, M, cell_key, aij, q * PYOA_SUBSTRATUM_KEY);
+    return oa_value(row, stratum, sub, q * PYOA_JITTER_KEY, M, s, J, offset);
 }

@@ -1,18 +1,10 @@
 /* pmj02: padded progressive multi-jittered (0,2) sequences (mirrors
  * pyoa/reference/pmj02.py, which holds the mathematics and references).
  * Values are k * 2^-24 with k a 24-bit integer: exact in float, no rounding.
- * Uses hash_pair (hashes.cl) and derived_seed (baselines.cl). */
+ * Uses hash_pair (pyoa/hashes.h) and derived_seed (baselines.cl). */
 
-/* PMJ02_KEY and PMJ02_SHIFT_KEY are not defined here: pyoa/_opencl/program.py's
- * defines() passes them as -D build options (uint literals), generated from
- * the constants of the same names in pyoa/reference/pmj02.py, their only
- * definition. */
-#ifndef PMJ02_KEY
-#error "PMJ02_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef PMJ02_SHIFT_KEY
-#error "PMJ02_SHIFT_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
+/* PYOA_PMJ02_KEY and PYOA_PMJ02_SHIFT_KEY come from pyoa/keys.h, generated from
+ * pyoa/reference/pmj02.py, their only definition. */
 
 /* The table layout, pyoa.pmj02_tables.SETS and .POINTS (tests/test_pmj02.py
  * checks that these literals equal them): SETS = 16 because h >> 28 picks
@@ -30,9 +22,9 @@
 float sample_pmj02(uint i, uint j, uint p, __global const uint *table)
 {
     uint c = j & 1u;
-    uint h = derived_seed(p, j >> 1, PMJ02_KEY);
-    uint shift = derived_seed(h, 1u + c, PMJ02_SHIFT_KEY) >> 8;
-    uint g = owen_scramble(i, derived_seed(h, 0u, PMJ02_SHIFT_KEY)) & (PMJ02_POINTS - 1u);
+    uint h = derived_seed(p, j >> 1, PYOA_PMJ02_KEY);
+    uint shift = derived_seed(h, 1u + c, PYOA_PMJ02_SHIFT_KEY) >> 8;
+    uint g = owen_scramble(i, derived_seed(h, 0u, PYOA_PMJ02_SHIFT_KEY)) & (PMJ02_POINTS - 1u);
     uint k = table[((h >> 28) * PMJ02_POINTS + g) * 2u + c];
     return convert_float(k ^ shift) * 0x1.0p-24f;
 }

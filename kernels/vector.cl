@@ -1,10 +1,10 @@
 /* The vector path: the orthogonal-array samplers' kernels specialized per
- * request shape, built by pyoa/_opencl/vector.py after hashes.cl and
- * floats.cl with these -D constants (docs/performance.md, "The vector
+ * request shape, built by pyoa/_opencl/vector.py after pyoa/hashes.h and
+ * pyoa/floats.h with these -D constants (docs/performance.md, "The vector
  * path"):
  *
  *   VS, VM          s and M = N / s
- *   VWS, VWM        walk masks of s and M (walk_mask in hashes.cl)
+ *   VWS, VWM        walk masks of s and M (walk_mask in pyoa/hashes.h)
  *   VND, VNK        dimensions and sample positions of the request
  *   VNKP            VNK rounded up to whole blocks of 8
  *   VDMAX           dimensions per block (docs/spec.md section 6)
@@ -52,14 +52,14 @@
  * below l after at most (w + 1 - l) values at or above l, so w + 2 - l
  * rounds always end it (and the host only builds this path when that is at
  * most MAX_ROUNDS of pyoa/_opencl/vector.py). Lanes that are done keep
- * their value. Then the final shift of permute (hashes.cl). Lanes with p == 0
+ * their value. Then the final shift of permute (pyoa/hashes.h). Lanes with p == 0
  * are the identity. */
 static inline __attribute__((always_inline)) uint8 permute_bounded_v8(uint8 i, uint8 p, uint l, uint w, uint rounds)
 {
-    uint8 x = permute_round_v8(i, p, w);
+    uint8 x = pyoa_permute_round_v8(i, p, w);
     #pragma unroll
     for (uint r = 1u; r < rounds; ++r)  /* rounds is a build constant: unrolled */
-        x = (x < l) ? x : permute_round_v8(x, p, w);
+        x = (x < l) ? x : pyoa_permute_round_v8(x, p, w);
     x += p % l;
     x = (x >= l) ? x - l : x;
     return (p != 0u) ? x : i;
@@ -86,7 +86,7 @@ static inline __attribute__((always_inline)) void permutation_fields_v8(uint l, 
     uint8 rlo = 0u, rhi = 0u;
     #pragma unroll
     for (uint x = 0u; x <= w; ++x) {  /* w and l are build constants: every loop unrolls */
-        uint8 r = convert_uint8(permute_round16_v8((ushort8)(ushort)x, p, (ushort)w)) << (4u * (x & 7u));
+        uint8 r = convert_uint8(pyoa_permute_round16_v8((ushort8)(ushort)x, p, (ushort)w)) << (4u * (x & 7u));
         if (x < 8u) rlo |= r; else rhi |= r;
     }
     uint8 sh = p % l, lo = 0u, hi = 0u;
@@ -125,14 +125,14 @@ __kernel void vector_tables(__global uint *restrict pk,
     uint g = (uint)get_global_id(0);
     uint8 pd = 8u * g + (uint8)(0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u), pix = pd / VND;
     uint8 j = gather_v8(dims, pd - pix * VND), block = j / VDMAX;
-    uint8 P = block_seed_v8(pixel_seed_v8(seed, gather_v8(pixels, pix)), block);
-    uint8 q = P * (j - block * VDMAX + 1u), os = block_order_seed_v8(P, block, VN);
-    uint8 w0 = q * STRATUM_KEY, w1 = 0u, w2 = q * SUBSTRATUM_KEY, w3 = 0u, w4 = q * JITTER_KEY;
+    uint8 P = pyoa_block_seed_v8(pyoa_pixel_seed_v8(seed, gather_v8(pixels, pix)), block);
+    uint8 q = P * (j - block * VDMAX + 1u), os = pyoa_block_order_seed_v8(P, block, VN);
+    uint8 w0 = q * PYOA_STRATUM_KEY, w1 = 0u, w2 = q * PYOA_SUBSTRATUM_KEY, w3 = 0u, w4 = q * PYOA_JITTER_KEY;
 #if VS_PACKED
-    permutation_fields_v8(VS, VWS, q * STRATUM_KEY, &w0, &w1);
+    permutation_fields_v8(VS, VWS, q * PYOA_STRATUM_KEY, &w0, &w1);
 #endif
 #if VSUB == 1
-    permutation_fields_v8(VM, VWM, q * SUBSTRATUM_KEY, &w2, &w3);
+    permutation_fields_v8(VM, VWM, q * PYOA_SUBSTRATUM_KEY, &w2, &w3);
 #endif
     __global uint *o = pk + 64u * g;
     #pragma unroll
@@ -188,9 +188,9 @@ static inline __attribute__((always_inline)) float8 value_v8(
 #else
     uint8 stratum = permute_bounded_v8(aij, (uint8)w[0], VS, VWS, VS_ROUNDS);
 #endif
-    float8 jit = jitter_value_v8(randfloat_v8(row, w[4]), J);
+    float8 jit = pyoa_jitter_value_v8(pyoa_randfloat_v8(row, w[4]), J);
 #if VSUB == 0
-    return centered_value_v8(stratum, jit, VM, VS);
+    return pyoa_centered_value_v8(stratum, jit, VM, VS);
 #else
 #if VSUB == 1
     uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
@@ -208,7 +208,7 @@ static inline __attribute__((always_inline)) float8 value_v8(
 #endif
     uint8 sub = permute_bounded_v8(u, seed, VM, VWM, VSUB_ROUNDS);
 #endif
-    return sample_value_v8(stratum, sub, jit, VM, VS);
+    return pyoa_sample_value_v8(stratum, sub, jit, VM, VS);
 #endif
 }
 
@@ -247,12 +247,12 @@ static inline __attribute__((always_inline)) void permute_walks(ushort16 *x, uin
      * walk from x < VN stays on x's own cycle) and its walk would not end:
      * from any other y, at most VNOUT rounds lead below VN. */
     ushort16 wo = min((ushort16)n + (ushort16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15), (ushort16)w);
-    wo = permute_round16_v16(wo, p, w);
+    wo = pyoa_permute_round16_v16(wo, p, w);
     for (uint r = 1u; r < VNOUT && any(wo >= n); ++r)
-        wo = (wo < n) ? wo : permute_round16_v16(wo, p, w);
+        wo = (wo < n) ? wo : pyoa_permute_round16_v16(wo, p, w);
     #pragma unroll
     for (uint c = 0u; c < WALK_VECTORS; ++c) {
-        ushort16 y = permute_round16_v16(x[c], p, w), z = y;
+        ushort16 y = pyoa_permute_round16_v16(x[c], p, w), z = y;
         #pragma unroll
         for (uint o = 0u; o < VNOUT; ++o)
             z = (y == (ushort)(VN + o)) ? (ushort16)wo[o] : z;
@@ -261,7 +261,7 @@ static inline __attribute__((always_inline)) void permute_walks(ushort16 *x, uin
 #else
     #pragma unroll
     for (uint c = 0u; c < WALK_VECTORS; ++c)
-        x[c] = permute_round16_v16(x[c], p, w);
+        x[c] = pyoa_permute_round16_v16(x[c], p, w);
     for (;;) {
         short16 out = 0;
         #pragma unroll
@@ -271,7 +271,7 @@ static inline __attribute__((always_inline)) void permute_walks(ushort16 *x, uin
             break;
         #pragma unroll
         for (uint c = 0u; c < WALK_VECTORS; ++c)
-            x[c] = (x[c] < n) ? x[c] : permute_round16_v16(x[c], p, w);
+            x[c] = (x[c] < n) ? x[c] : pyoa_permute_round16_v16(x[c], p, w);
     }
 #endif
     /* (x + p % N) mod N without leaving 16 bits: x + sh reaches 2 N - 2,
@@ -308,7 +308,7 @@ __kernel void vector_rows(__global uint *restrict rowtab,
                                              vload8(min(2u * v + 1u, VNKP / 8u - 1u), isamp)));
         }
         permute_walks(x, order);
-        permute_walks(x, mix32(order));
+        permute_walks(x, pyoa_mix32(order));
         #pragma unroll
         for (uint c = 0u; c < WALK_VECTORS; ++c) {
             uint16 r = convert_uint16(x[c]);
@@ -430,27 +430,27 @@ __kernel void vector_baseline(__global float *restrict out,
 {
     uint b = (uint)get_global_id(0), pl = (uint)get_global_id(1);
     uint8 i = vload8(b, isamp);
-    uint p = pixel_seed(seed, pixels[pl]);
+    uint p = pyoa_pixel_seed(seed, pixels[pl]);
     float8 V[VND];
     #pragma unroll
     for (uint d = 0u; d < VND; ++d) {
         uint j = dims[d];
-        uint q = derived_seed(p, j >> 1, PAD_KEY);
-        uint8 k = permute_bounded_v8(i, (uint8)(q * SHUFFLE_KEY), VBN, walk_mask(VBN), VBN_ROUNDS);
+        uint q = derived_seed(p, j >> 1, PYOA_PAD_KEY);
+        uint8 k = permute_bounded_v8(i, (uint8)(q * PYOA_SHUFFLE_KEY), VBN, pyoa_walk_mask(VBN), VBN_ROUNDS);
         bool even = (j & 1u) == 0u;
 #if VBASELINE == 1
-        float8 jit = jitter_value_v8(randfloat_v8(k, q * (even ? JITX_KEY : JITY_KEY)), J);
+        float8 jit = pyoa_jitter_value_v8(pyoa_randfloat_v8(k, q * (even ? PYOA_JITX_KEY : PYOA_JITY_KEY)), J);
         if (even && j + 1u == VBB)  /* a lone last dimension */
-            V[d] = sample_value_v8(k, (uint8)0u, jit, 1u, VBN);
+            V[d] = pyoa_sample_value_v8(k, (uint8)0u, jit, 1u, VBN);
         else
-            V[d] = sample_value_v8(even ? k % VBA : k / VBA, (uint8)0u, jit, 1u, VBA);
+            V[d] = pyoa_sample_value_v8(even ? k % VBA : k / VBA, (uint8)0u, jit, 1u, VBA);
 #else
         if (even) {
-            uint8 sy = permute_bounded_v8(k / VBA, (uint8)(q * SUBY_KEY), VBB, walk_mask(VBB), VBB_ROUNDS);
-            V[d] = sample_value_v8(k % VBA, sy, jitter_value_v8(randfloat_v8(k, q * JITX_KEY), J), VBB, VBA);
+            uint8 sy = permute_bounded_v8(k / VBA, (uint8)(q * PYOA_SUBY_KEY), VBB, pyoa_walk_mask(VBB), VBB_ROUNDS);
+            V[d] = pyoa_sample_value_v8(k % VBA, sy, pyoa_jitter_value_v8(pyoa_randfloat_v8(k, q * PYOA_JITX_KEY), J), VBB, VBA);
         } else {
-            uint8 sx = permute_bounded_v8(k % VBA, (uint8)(q * SUBX_KEY), VBA, walk_mask(VBA), VBA_ROUNDS);
-            V[d] = sample_value_v8(k / VBA, sx, jitter_value_v8(randfloat_v8(k, q * JITY_KEY), J), VBA, VBB);
+            uint8 sx = permute_bounded_v8(k % VBA, (uint8)(q * PYOA_SUBX_KEY), VBA, pyoa_walk_mask(VBA), VBA_ROUNDS);
+            V[d] = pyoa_sample_value_v8(k / VBA, sx, pyoa_jitter_value_v8(pyoa_randfloat_v8(k, q * PYOA_JITY_KEY), J), VBA, VBB);
         }
 #endif
     }

@@ -1,18 +1,11 @@
 /* zsobol: pbrt-v4's ZSobolSampler with pyoa's hashes (mirrors
  * pyoa/reference/zsobol.py, which holds the mathematics and references, and
- * pyoa/_numpy/zsobol.py). Uses hash_pair (hashes.cl) and unit24,
+ * pyoa/_numpy/zsobol.py). Uses hash_pair (pyoa/hashes.h) and unit24,
  * reverse_bits, owen_scramble (baselines.cl). Values are k * 2^-24 with k a
  * 24-bit integer: exact in float, no rounding. */
 
-/* ZSOBOL_KEY (pyoa/reference/zsobol.py) and OWEN_KEY (baselines.py) are not
- * defined here: pyoa/_opencl/program.py's defines() passes them as -D build
- * options, generated from the Python constants, their only definition. */
-#ifndef ZSOBOL_KEY
-#error "ZSOBOL_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
-#ifndef OWEN_KEY
-#error "OWEN_KEY undefined: build with pyoa._opencl.program.defines()"
-#endif
+/* PYOA_ZSOBOL_KEY (pyoa/reference/zsobol.py) and PYOA_OWEN_KEY (baselines.py) come
+ * from pyoa/keys.h, generated from those constants, their only definition. */
 
 /* pbrt-v4's MixBits: a bijective avalanche hash of a ulong. */
 ulong mix64(ulong v)
@@ -87,7 +80,7 @@ uint zsobol_sobol_bits(uint g, uint c)
 float sample_zsobol(uint i, uint j, uint log2n, uint log2res, uint width, uint pixel, uint seed)
 {
     uint c = j & 1u;
-    uint q = hash_pair(seed, j >> 1, ZSOBOL_KEY);
+    uint q = pyoa_hash_pair(seed, j >> 1, PYOA_ZSOBOL_KEY);
     uint g = zsobol_index(i, log2n, log2res, width, pixel, q);
-    return unit24(owen_scramble(zsobol_sobol_bits(g, c), hash_pair(q, 1u + c, OWEN_KEY)));
+    return unit24(owen_scramble(zsobol_sobol_bits(g, c), pyoa_hash_pair(q, 1u + c, PYOA_OWEN_KEY)));
 }

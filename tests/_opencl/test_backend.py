@@ -123,10 +123,11 @@ def _reference_keys() -> dict[str, int]:
 KERNEL_KEYS = _reference_keys()
 
 
-def test_kernel_keys_are_build_defines_of_the_python_constants():
-    """The *_KEY values reach the kernels only as -D options generated from the
-    Python constants: the defines equal them, every key a kernel names is passed
-    and guarded by an #ifndef/#error, and no .cl file #defines a key itself."""
+def test_kernel_keys_come_from_the_generated_header_only():
+    """The *_KEY values reach the kernels only through pyoa/keys.h, generated
+    from the Python constants: its defines equal them, the program text holds
+    it before any kernel, no build option and no .cl file defines a key, and
+    every key a kernel names is one of them."""
     import re
     from importlib import resources
 
@@ -135,9 +136,9 @@ def test_kernel_keys_are_build_defines_of_the_python_constants():
 
     want = dict(KERNEL_KEYS)
     assert want["PIXEL_KEY"] == 0x5BD1E995 and want["OWEN_KEY"] == 0xCC9E2D51  # the collection finds keys
-    key_opts = [opt for opt in program.defines() if re.match(r"-D\w*_KEY=", opt)]
-    assert sorted(key_opts) == sorted(f"-D{name}=0x{value:08x}u" for name, value in want.items())
-    got = {m[1]: int(m[2], 16) for m in (re.fullmatch(r"-D(\w+)=0x([0-9a-f]{8})u", opt) for opt in key_opts)}
+    assert not [opt for opt in program.defines() if re.match(r"-D\w*_KEY=", opt)]
+    keys_h = resources.files(kernels).joinpath("include", "pyoa", "keys.h").read_text()
+    got = {m[1]: int(m[2], 16) for m in re.finditer(r"^#define PYOA_(\w+_KEY) 0x([0-9a-f]{8})u$", keys_h, re.MULTILINE)}
     assert got == want
 
     cl_files = sorted(p for p in resources.files(kernels).iterdir() if p.name.endswith(".cl"))
@@ -145,35 +146,12 @@ def test_kernel_keys_are_build_defines_of_the_python_constants():
     for path in cl_files:
         text = path.read_text()
         defined = re.findall(r"^\s*#\s*define\s+(\w*_KEY)\b", text, re.MULTILINE)
-        assert not defined, f"kernels/{path.name} defines {defined}: keys come from program.defines() only"
+        assert not defined, f"kernels/{path.name} defines {defined}: keys come from pyoa/keys.h only"
     source = program.source()
-    # every key a kernel names is a define and guarded; a reference key no
-    # kernel uses (pmj02's table-builder keys) is passed but need not appear
-    used = set(re.findall(r"\b[A-Z][A-Z0-9_]*_KEY\b", source))
+    assert source.index("PYOA_PIXEL_KEY 0x") < source.index("---- gf.cl")
+    # every key a kernel names is in keys.h; a reference key no kernel uses
+    # (pmj02's table-builder keys) is there but need not be used
+    used = set(re.findall(r"\bPYOA_([A-Z][A-Z0-9_]*_KEY)\b", "".join(p.read_text() for p in cl_files)))
     assert used <= set(want) and {"PIXEL_KEY", "OWEN_KEY", "ZSOBOL_KEY", "PMJ02_KEY"} <= used
-    assert set(re.findall(r"^\s*#\s*ifndef\s+(\w+_KEY)\s*$", source, re.MULTILINE)) == used
 
 
-def _kernel_used_keys() -> list[str]:
-    """The *_KEY names the kernels/*.cl files use (read from the files)."""
-    import re
-    from pathlib import Path
-
-    import pyoa.kernels
-
-    text = "".join(p.read_text() for p in Path(pyoa.kernels.__file__).parent.glob("*.cl"))
-    return sorted(set(re.findall(r"\b[A-Z][A-Z0-9_]*_KEY\b", text)) & set(KERNEL_KEYS))
-
-
-@pytest.mark.parametrize("key", _kernel_used_keys())
-def test_program_without_a_key_define_does_not_build(monkeypatch, opencl, key):
-    """A key missing from the build options stops the build with an #error naming it."""
-    from pyoa._opencl import program
-
-    options = [opt for opt in program.defines() if not opt.startswith(f"-D{key}=")]
-    assert len(options) == len(program.defines()) - 1
-    monkeypatch.setattr(program, "defines", lambda: options)
-    with pytest.raises(program.BuildError) as exc:
-        # a text of its own: neither served from nor left in the build cache
-        program.build(opencl.info, text=program.source() + f"\n/* built without {key} */\n")
-    assert f"{key} undefined" in exc.value.log
