@@ -14,6 +14,7 @@ same float32 bits.
 
 from . import reference
 from .backends import PyoaFallbackWarning, backends
+from .c_headers import get_include
 from .catalogue import valid_spp
 from .catalogue_types import OFFSETS, SppChoice
 from .samplers import Sampler, sampler, samplers
@@ -22,7 +23,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "sampler", "samplers", "Sampler", "valid_spp", "SppChoice", "backends", "reference",
-    "OFFSETS", "PyoaFallbackWarning", "__version__",
+    "OFFSETS", "PyoaFallbackWarning", "get_include", "__version__",
 ]
 
 

@@ -209,3 +209,19 @@ def test_jitter_value_is_not_contracted(lib):
     fused = (np.float64(amount) * (np.float64(r) - 0.5) + 0.5).astype(np.float32)
     assert (bits(fused) != bits(want)).any()  # the inputs do tell the two apart
     assert bits(got).tolist() == bits(want).tolist()
+
+
+def test_a_wheel_ships_every_header():
+    """setup.cfg's package data for pyoa.kernels covers every header, so that
+    get_include() names a complete folder in a regular (non-editable) install."""
+    import configparser
+    import fnmatch
+
+    root = Path(__file__).resolve().parent.parent
+    cfg = configparser.ConfigParser()
+    cfg.read(root / "setup.cfg")
+    patterns = [pat.strip() for pat in cfg["options.package_data"]["pyoa.kernels"].split(",")]
+    headers = [p.relative_to(root / "kernels").as_posix() for p in (root / "kernels" / "include").rglob("*.h")]
+    assert headers
+    missing = [h for h in headers if not any(fnmatch.fnmatch(h, pat) for pat in patterns)]
+    assert not missing, f"headers outside setup.cfg's package_data for pyoa.kernels: {missing}"

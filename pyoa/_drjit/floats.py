@@ -1,5 +1,5 @@
 """Float32 rules of docs/spec.md section 7 in Dr.Jit operations (mirrors
-``kernels/floats.cl``: every value is clamped into its cell, branch-free).
+``kernels/include/pyoa/floats.h``: every value is clamped into its cell, branch-free).
 
 Dr.Jit emits one correctly rounded IEEE operation per ``+``, ``*`` and
 ``/`` on ``Float32`` and never contracts a multiply and an add into an FMA

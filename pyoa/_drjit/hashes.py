@@ -1,5 +1,5 @@
 """Integer hashes of docs/spec.md sections 2 and 3 in Dr.Jit operations
-(mirrors :mod:`pyoa._numpy.hashes` and ``kernels/hashes.cl``).
+(mirrors :mod:`pyoa._numpy.hashes` and ``kernels/include/pyoa/hashes.h``).
 
 Dr.Jit's ``UInt32`` arithmetic wraps modulo ``2**32`` as the spec requires.
 Constants above ``2**31`` are wrapped in the argument's own type first, so

@@ -60,7 +60,7 @@ MAX_WHOLE_ROWS = 16
 MAX_ROUNDS = 16
 
 #: ``vector_rows`` walks the later blocks' rows in 16-bit lanes
-#: (``permute_round16`` of kernels/hashes.cl), so a request with a dimension
+#: (``pyoa_permute_round16`` of kernels/include/pyoa/hashes.h), so a request with a dimension
 #: past block 0 takes the vector path only for arrays of fewer rows N = s M.
 MAX_ROWS16 = 1 << 16
 #: Words of the per-(pixel, dimension) table (kernels/vector.cl, vector_tables).

@@ -44,7 +44,7 @@ def walk_mask(l: int) -> int:
 
 def permute_round(i: int, p: int, w: int) -> int:
     """One round of Kensler's bijection on ``[0, w]`` with seed ``p``: the body
-    of :func:`permute`'s cycle walk (``permute_round`` of kernels/hashes.cl)."""
+    of :func:`permute`'s cycle walk (``pyoa_permute_round`` of kernels/include/pyoa/hashes.h)."""
     i ^= p
     i = (i * 0xE170893D) & MASK
     i ^= p >> 16
