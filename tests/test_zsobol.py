@@ -380,7 +380,7 @@ __kernel void tz_sample(__global const uint *i, __global const uint *j, __global
     size_t g = get_global_id(0);
     out[g] = sample_zsobol(i[g], j[g], log2n[g], log2res[g], width[g], pixel[g], seed[g]);
     index[g] = zsobol_index(i[g], log2n[g], log2res[g], width[g], pixel[g],
-                            hash_pair(seed[g], j[g] >> 1, ZSOBOL_KEY));
+                            pyoa_hash_pair(seed[g], j[g] >> 1, PYOA_ZSOBOL_KEY));
 }
 
 __kernel void tz_helpers(__global const uint *a, __global const uint *b, __global uint *perm,

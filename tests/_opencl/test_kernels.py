@@ -17,21 +17,21 @@ U32 = np.uint32
 
 TEST_KERNELS = r"""
 __kernel void t_permute(__global const uint *i, __global const uint *l, __global const uint *p, __global uint *out)
-{ size_t g = get_global_id(0); out[g] = permute(i[g], l[g], p[g]); }
+{ size_t g = get_global_id(0); out[g] = pyoa_permute(i[g], l[g], p[g]); }
 
 __kernel void t_randfloat(__global const uint *i, __global const uint *p, __global float *out)
-{ size_t g = get_global_id(0); out[g] = randfloat(i[g], p[g]); }
+{ size_t g = get_global_id(0); out[g] = pyoa_randfloat(i[g], p[g]); }
 
 __kernel void t_seeds(__global const uint *a, __global const uint *b, __global uint *mix,
                       __global uint *pix, __global uint *blk)
-{ size_t g = get_global_id(0); mix[g] = mix32(a[g]); pix[g] = pixel_seed(a[g], b[g]); blk[g] = block_seed(a[g], b[g]); }
+{ size_t g = get_global_id(0); mix[g] = pyoa_mix32(a[g]); pix[g] = pyoa_pixel_seed(a[g], b[g]); blk[g] = pyoa_block_seed(a[g], b[g]); }
 
 __kernel void t_sample_value(__global const uint *stratum, __global const uint *sub, __global const float *jit,
                              const uint M, const uint s, __global float *out)
-{ size_t g = get_global_id(0); out[g] = sample_value(stratum[g], sub[g], jit[g], M, s); }
+{ size_t g = get_global_id(0); out[g] = pyoa_sample_value(stratum[g], sub[g], jit[g], M, s); }
 
 __kernel void t_jitter_value(__global const float *r, const float J, __global float *out)
-{ size_t g = get_global_id(0); out[g] = jitter_value(r[g], J); }
+{ size_t g = get_global_id(0); out[g] = pyoa_jitter_value(r[g], J); }
 
 __kernel void t_bose(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
                      const uint offset, const float J, __global float *out)
