@@ -1,6 +1,8 @@
 /* Bulk generation. A request is rows = (pixel, sample) pairs, each of n_dims
  * values, written row-major; each launch fills one rectangle of it (see
- * below) starting at out[out0].
+ * below) starting at out[out0]. The values are those of the portable
+ * headers (include/pyoa: pyoa_oa_value of oa.h, pyoa_baseline_value of
+ * values.h), which pyoa._opencl.program puts before this file.
  *
  * Two paths for the orthogonal arrays, the same bits:
  * - generate: one work-item per value, everything from scratch (any offset);
@@ -11,12 +13,8 @@
  *   loop in a kernel keeps PoCL scalar). Table entry layout per (pixel,
  *   dimension), E entries: [0, s) stratum permutation, [s, s + M)
  *   sub-stratum permutation ('cmj' only), [E - 1] the jitter seed P3.
- * The comparison samplers have one kernel each (generate_<name>).
- *
- * Which construction or comparison sampler a kernel computes is not written
- * here: pyoa._opencl.program.dispatch_source generates oa_dispatch (one case
- * per orthogonal array of the catalogue) and the generate_<name> kernels
- * (GENERATE_BASELINE below) from the catalogue, after this file. */
+ * The comparison samplers have one kernel each (generate_<name>, at the end
+ * of this file). */
 
 /* Every kernel runs over a rectangle of the request (whole pixels, or a run
  * of samples of one pixel) as a 2D NDRange: axis 0 is the sample position k
@@ -48,12 +46,6 @@ uint rect_index(uint out0, uint k, uint pl, uint d, uint n_k, uint n_dims)
     uint i = samples[k], j = dims[d], pixel = pixels[pl];                               \
     uint p = pyoa_pixel_seed(seed, pixel)
 
-/* The value of construction `construction` (its CONSTRUCTION_* code) with B
- * columns per block, N rows and M sub-strata: generated from the catalogue
- * (pyoa._opencl.program.dispatch_source). */
-float oa_dispatch(uint construction, uint i, uint j, uint s, uint t, uint B, uint N, uint M, uint p,
-                  uint offset, float J, __global const ushort *gf, uint gf_tabled, __global const uint *consts);
-
 /* The direct path: any offset, everything from scratch (permute's cycle walk
  * keeps this kernel scalar on PoCL). */
 __kernel void generate(RECT_ARGS,
@@ -71,8 +63,8 @@ __kernel void generate(RECT_ARGS,
                        __global const uint *consts)
 {
     RECT_PRELUDE;
-    out[rect_index(out0, k, pl, d, n_k, n_dims)] = oa_dispatch(construction, i, j, s, t, B, N, M, p, offset, J,
-                                                               gf, gf_tabled, consts);
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] = pyoa_oa_value(construction, i, j, s, t, B, N, M, p, offset, J,
+                                                                 gf, gf_tabled, consts);
 }
 
 /* The table path, in two launches over a rectangle of pixels x samples
@@ -227,11 +219,12 @@ __kernel void block_rows(__global uint *restrict rows,
 /* The comparison samplers: one kernel each, one work-item per value, over a
  * rectangle like `generate`. a, b and c are the sampler's shape arguments
  * (its catalogue entry's shape_args, zero-padded), `table` its constants
- * (Halton's primes, Sobol's direction numbers, pmj02's point sets); `pixel`
- * and `seed` are in scope for samplers that use the image position. The
- * instances, one per comparison sampler of the catalogue, are generated
- * (pyoa._opencl.program.dispatch_source). */
-#define GENERATE_BASELINE(NAME, EXPR)                                                   \
+ * (Halton's primes, Sobol's direction numbers, pmj02's point sets). One
+ * kernel per sampler rather than one with a code argument: with the code a
+ * constant, pyoa_baseline_value's switch folds away and each kernel is
+ * compiled for its sampler alone. tests/test_catalogue.py checks that every
+ * comparison sampler of the catalogue has its kernel here. */
+#define GENERATE_BASELINE(NAME, CODE)                                                   \
 __kernel void generate_##NAME(RECT_ARGS,                                                \
                               const uint seed,                                          \
                               const uint a,                                             \
@@ -241,5 +234,16 @@ __kernel void generate_##NAME(RECT_ARGS,                                        
                               __global const uint *table)                               \
 {                                                                                       \
     RECT_PRELUDE;                                                                       \
-    out[rect_index(out0, k, pl, d, n_k, n_dims)] = EXPR;                                \
+    out[rect_index(out0, k, pl, d, n_k, n_dims)] =                                      \
+        pyoa_baseline_value(CODE, i, j, p, pixel, seed, a, b, c, J, table);             \
 }
+
+GENERATE_BASELINE(random, PYOA_SAMPLER_RANDOM)
+GENERATE_BASELINE(jittered2d, PYOA_SAMPLER_JITTERED2D)
+GENERATE_BASELINE(cmj2d, PYOA_SAMPLER_CMJ2D)
+GENERATE_BASELINE(sobol02, PYOA_SAMPLER_SOBOL02)
+GENERATE_BASELINE(halton, PYOA_SAMPLER_HALTON)
+GENERATE_BASELINE(sobol, PYOA_SAMPLER_SOBOL)
+GENERATE_BASELINE(zsobol, PYOA_SAMPLER_ZSOBOL)
+GENERATE_BASELINE(pmj02, PYOA_SAMPLER_PMJ02)
+GENERATE_BASELINE(faure, PYOA_SAMPLER_FAURE)

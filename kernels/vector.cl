@@ -18,7 +18,7 @@
  *   VCB, VCPW       bits of one packed cell and cells per record word
  *   VAB, VAMASK, VUMASK   bits of A_ij in a cell, then the masks of A_ij and of u
  *   VGROUPED        1: more than 16 dimensions, computed and stored in groups of 8
- *   VOFFSET         the offset's code (OFFSET_* of pyoa.constructions)
+ *   VOFFSET         the offset's code (PYOA_OFFSET_* of pyoa/keys.h)
  *   VS_PACKED       1: the stratum permutation is tabled as 4-bit fields
  *                   (s <= 16); 0: each value walks it (VS_ROUNDS rounds)
  *   VSUB            0 none ('centered'), 1 tabled as 4-bit fields ('cmj',
@@ -195,13 +195,13 @@ static inline __attribute__((always_inline)) float8 value_v8(
 #if VSUB == 1
     uint8 sub = field4_v8((uint8)w[2], (uint8)w[3], u);
 #else
-#if VOFFSET == OFFSET_J
+#if VOFFSET == PYOA_OFFSET_J
 #if VJKEY_BOSE
     uint8 seed = (u * VS + aij + 1u) * w[2];
 #else
     uint8 seed = (row + 1u) * w[2];
 #endif
-#elif VOFFSET == OFFSET_MJ
+#elif VOFFSET == PYOA_OFFSET_MJ
     uint8 seed = (aij + 1u) * w[2];
 #else
     uint8 seed = (uint8)w[2];
@@ -415,9 +415,9 @@ __kernel void vector_values(__global float *restrict out,
 #endif  /* VBASELINE */
 
 #ifdef VBASELINE
-/* The padded 2D comparison samplers (baselines.cl), VBASELINE 1 =
+/* The padded 2D comparison samplers (pyoa/baselines.h), VBASELINE 1 =
  * jittered2d (grid VBA x VBA; VBB is the request's dims, for the lone last
- * dimension), 2 = cmj2d (grid VBA x VBB). Each permute of baselines.cl is a
+ * dimension), 2 = cmj2d (grid VBA x VBB). Each permute of pyoa/baselines.h is a
  * bounded walk here (VBN_ROUNDS for the sample order on [0, VBN), VBA_ROUNDS
  * and VBB_ROUNDS for the sub-strata); the rest as in vector_values. */
 __kernel void vector_baseline(__global float *restrict out,
@@ -435,7 +435,7 @@ __kernel void vector_baseline(__global float *restrict out,
     #pragma unroll
     for (uint d = 0u; d < VND; ++d) {
         uint j = dims[d];
-        uint q = derived_seed(p, j >> 1, PYOA_PAD_KEY);
+        uint q = pyoa_derived_seed(p, j >> 1, PYOA_PAD_KEY);
         uint8 k = permute_bounded_v8(i, (uint8)(q * PYOA_SHUFFLE_KEY), VBN, pyoa_walk_mask(VBN), VBN_ROUNDS);
         bool even = (j & 1u) == 0u;
 #if VBASELINE == 1

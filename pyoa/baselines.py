@@ -168,7 +168,7 @@ class Random(Baseline):
     spp_invariant = True
     reference = staticmethod(_reference_baselines.random)
     numpy = staticmethod(_numpy_baselines.random)
-    kernel = "sample_random(i, j, p)"
+    kernel = "pyoa_sample_random"
     description = "independent uniform random values (no stratification): any N"
 
     def params(self, spp, dims):
@@ -194,7 +194,7 @@ class Jittered2D(Baseline):
     vector_kind = 1
     reference = staticmethod(_reference_baselines.jittered2d)
     numpy = staticmethod(_numpy_baselines.jittered2d)
-    kernel = "sample_jittered2d(i, j, a, b, p, J)"
+    kernel = "pyoa_sample_jittered2d"
     description = "padded 2D jittered: N = m^2, each pair of dimensions an m x m jittered grid"
 
     def valid(self, spp):
@@ -245,7 +245,7 @@ class CMJ2D(Baseline):
     vector_kind = 2
     reference = staticmethod(_reference_baselines.cmj2d)
     numpy = staticmethod(_numpy_baselines.cmj2d)
-    kernel = "sample_cmj2d(i, j, a, b, p, J)"
+    kernel = "pyoa_sample_cmj2d"
     description = "padded 2D correlated multi-jittered (Kensler): any N = m x n, the most nearly square grid"
 
     def params(self, spp, dims):
@@ -285,7 +285,7 @@ class Sobol02(Baseline):
     counts = "pow2"
     reference = staticmethod(_reference_baselines.sobol02)
     numpy = staticmethod(_numpy_baselines.sobol02)
-    kernel = "sample_sobol02(i, j, a, p, table)"
+    kernel = "pyoa_sample_sobol02"
     description = "padded (0,2)-sequence, Owen-scrambled and shuffled per pair: N a power of two"
 
     def params(self, spp, dims):
@@ -322,7 +322,7 @@ class Halton(Baseline):
     spp_invariant = True
     reference = staticmethod(_reference_baselines.halton)
     numpy = staticmethod(_numpy_baselines.halton)
-    kernel = "sample_halton(i, j, p, table)"
+    kernel = "pyoa_sample_halton"
     max_dims = sequences.HALTON_MAX_DIMS
     more_dims_hint = " (one prime base below 2^16 each); use sobol (21201) or a padded sampler for more"
     description = f"Owen-scrambled Halton: any N, up to {sequences.HALTON_MAX_DIMS} dimensions"
@@ -355,7 +355,7 @@ class Sobol(Baseline):
     counts = "pow2"
     reference = staticmethod(_reference_baselines.sobol)
     numpy = staticmethod(_numpy_baselines.sobol)
-    kernel = "sample_sobol(i, j, p, table)"
+    kernel = "pyoa_sample_sobol"
     max_dims = sequences.SOBOL_MAX_DIMS
     more_dims_hint = " (the Joe-Kuo table); use a padded sampler for more"
     description = (f"Owen-scrambled Sobol (Joe-Kuo directions): N a power of two, "
@@ -394,7 +394,7 @@ class ZSobol(Baseline):
     needs_resolution = True
     reference = staticmethod(_reference_zsobol.zsobol)
     numpy = staticmethod(_numpy_zsobol.zsobol)
-    kernel = "sample_zsobol(i, j, a, b, c, pixel, seed)"
+    kernel = "pyoa_sample_zsobol"
     description = ("pbrt-v4's Z-order Sobol (Ahmed-Wonka): N a power of two, blue-noise error across pixels; "
                    "needs resolution=(width, height)")
 
@@ -459,7 +459,7 @@ class PMJ02(Baseline):
     max_spp = _reference_pmj02.POINTS
     reference = staticmethod(_reference_pmj02.pmj02)
     numpy = staticmethod(_numpy_pmj02.pmj02)
-    kernel = "sample_pmj02(i, j, p, table)"
+    kernel = "pyoa_sample_pmj02"
     description = (f"progressive multi-jittered (0,2) (Christensen et al.): N a power of two up to "
                    f"2^{_reference_pmj02.POINTS_LOG2}, every power-of-two prefix a (0,2)-net")
 

@@ -12,13 +12,15 @@ implementations, which give the same bits:
 ``numpy``
     its vectorized mirror in :mod:`pyoa._numpy`;
 ``kernel``
-    the OpenCL C expression that computes one value in ``kernels/`` (the
-    dispatch of ``kernels/generate.cl`` is generated from it,
-    :func:`pyoa._opencl.program.dispatch_source`).
+    the name of its C function in the portable headers
+    (``kernels/include/pyoa``), which the OpenCL kernels and the C API
+    dispatch to by the entry's code (``PYOA_SAMPLER_<NAME>`` of
+    ``pyoa/keys.h``, generated from the catalogue).
 
 Each is called as ``function(i, j, *shape_args(params), *seed_args(...),
-*options(offset, jitter))``. Registration is all a new sampler needs: the
-backends, the kernel dispatch, the name lists and the conformance and
+*options(offset, jitter))``. Registration, with its C function and a case in the
+headers' dispatch, is all a new sampler needs: the
+backends, the name lists and the conformance and
 property suites (``tests/test_catalogue.py``) are built from the registry.
 
 This module imports only the seed hashes below it (:mod:`pyoa.reference`,
@@ -230,13 +232,16 @@ class Construction:
     Subclasses define :meth:`choices` (every valid sample count),
     :meth:`solve` and :meth:`invalid` (the parameters for a requested count,
     or why there are none) and their implementations: ``reference`` and
-    ``numpy`` (functions, as ``staticmethod``) and ``kernel``: OpenCL C. For
-    the orthogonal arrays it is the construction's cell alone, statements
-    over ``row, col, s, t, M, gf, gf_tabled, consts`` that set ``aij``,
-    ``u`` and the 'j' offset's cell key ``ck`` (the block rule and the
-    common tail are shared, ``kernels/oa.cl``); for the comparison samplers
-    an expression over ``i, j, p, pixel, seed, a, b, c, J, table`` with
-    ``a, b, c`` the shape arguments.
+    ``numpy`` (functions, as ``staticmethod``) and ``kernel``: the name of
+    its C function in the portable headers (``kernels/include/pyoa``), which
+    the OpenCL kernels and the C API call. For the orthogonal arrays it is
+    the construction's cell (``pyoa_<name>_cell`` of ``pyoa/oa.h``, whose
+    signature all cells share; the block rule and the common tail are
+    shared, ``pyoa_oa_value``); for the comparison samplers the value
+    function (``pyoa_sample_<name>``) that ``pyoa_baseline_value`` of
+    ``pyoa/values.h`` calls. Each is dispatched by the entry's ``code``
+    (``PYOA_SAMPLER_<NAME>`` in ``pyoa/keys.h``, generated from the
+    catalogue).
     """
 
     name: str
@@ -392,7 +397,7 @@ def register(cls: type[Construction]) -> type[Construction]:
         if not callable(getattr(cls, attr, None)):
             raise TypeError(f"{cls.__name__} must name its {attr} implementation")
     if not entry.kernel:
-        raise TypeError(f"{cls.__name__} must give its OpenCL expression (kernel)")
+        raise TypeError(f"{cls.__name__} must name its C function in the headers (kernel)")
     if entry.name in REGISTRY:
         raise ValueError(f"sampler name {entry.name!r} is registered twice")
     taken = {c.code: c.name for c in REGISTRY.values()}

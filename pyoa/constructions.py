@@ -120,7 +120,7 @@ class Bose(_OA):
     reference = staticmethod(_reference_oa.bose)
     geometry = staticmethod(_reference_oa.bose_geometry)
     numpy = staticmethod(_numpy_oa.bose)
-    kernel = "bose_cell(row, col, s, gf, gf_tabled, &aij, &u); ck = u * s + aij + 1u"
+    kernel = "pyoa_bose_cell"
     description = "Bose OA, strength 2: N = s^2 with s a prime power, s+1 dimensions per block"
     #: the largest prime with s**2 <= MAX_SPP
     max_s = max(p for p in range(math.isqrt(MAX_SPP), 1, -1) if is_prime(p))
@@ -166,7 +166,7 @@ class Bush(_OA):
     reference = staticmethod(_reference_oa.bush)
     geometry = staticmethod(_reference_oa.bush_geometry)
     numpy = staticmethod(_numpy_oa.bush)
-    kernel = "bush_cell(row, col, s, t, M, gf, gf_tabled, &aij, &u); ck = row + 1u"
+    kernel = "pyoa_bush_cell"
     #: t <= s and s**t <= 2**24 allow t <= 8 (8**8 = 2**24; 9**9 is too large)
     max_strength = 8
     description = "Bush OA, strength t: N = s^t with s a prime power and t <= s, s+1 dimensions per block"
@@ -226,7 +226,7 @@ class CMJND(_OA):
     reference = staticmethod(_reference_oa.cmjnd)
     geometry = staticmethod(_reference_oa.cmjnd_geometry)
     numpy = staticmethod(_numpy_oa.cmjnd)
-    kernel = "cmjnd_cell(row, s, pow_u(s, col), &aij, &u); ck = row + 1u"
+    kernel = "pyoa_cmjnd_cell"
     description = "N-dimensional correlated multi-jittered OA: N = s^t for any s >= 2, t dimensions per block"
     max_strength = 24  # 2**24 = MAX_SPP
 
@@ -322,7 +322,7 @@ class AddelmanKempthorne(_Index2):
     geometry = staticmethod(_reference_oa.addelman_kempthorne_geometry)
     numpy = staticmethod(_numpy_oa.addelman_kempthorne)
     cell = staticmethod(_numpy_oa.addelman_kempthorne_cell)
-    kernel = "addelman_kempthorne_cell(row, col, s, gf, gf_tabled, consts, &aij, &u); ck = row + 1u"
+    kernel = "pyoa_addelman_kempthorne_cell"
     description = ("Addelman-Kempthorne OA, strength 2, index 2: N = 2q^2 with q an odd prime power, "
                    "2q+1 dimensions per block")
 
@@ -357,7 +357,7 @@ class BoseBush(_Index2):
     geometry = staticmethod(_reference_oa.bose_bush_geometry)
     numpy = staticmethod(_numpy_oa.bose_bush)
     cell = staticmethod(_numpy_oa.bose_bush_cell)
-    kernel = "bose_bush_cell(row, col, s, gf, gf_tabled, &aij, &u); ck = row + 1u"
+    kernel = "pyoa_bose_bush_cell"
     description = "Bose-Bush OA, strength 2, index 2: N = 2s^2 with s a power of two, 2s+1 dimensions per block"
 
     @staticmethod

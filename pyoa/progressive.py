@@ -110,7 +110,7 @@ class Faure(Baseline):
     spp_invariant = True
     reference = staticmethod(_reference_faure.faure)
     numpy = staticmethod(_numpy_faure.faure)
-    kernel = "sample_faure(i, j, a, b, p)"
+    kernel = "pyoa_sample_faure"
     description = (f"Owen-scrambled Faure (0,s)-sequence in a prime base b <= {MAX_BASE} (base=): any N, every "
                    "b^m block a (0,m,b)-net, progressive")
 

@@ -655,7 +655,7 @@ def kernel_runner(backend, test_kernels: str):
     from pyoa._opencl import program as prog
 
     ctx, queue = backend.context, backend.queue
-    program = cl.Program(ctx, prog.source() + "\n" + test_kernels).build(options=prog.BUILD_OPTIONS + prog.defines())
+    program = cl.Program(ctx, prog.source() + "\n" + test_kernels).build(options=prog.BUILD_OPTIONS)
     kernels = {}
 
     def run(name, outs, *args, n=None):

@@ -1,6 +1,6 @@
 """Bit-exact conformance of the comparison samplers (random, jittered2d, cmj2d,
 sobol02, halton, sobol): every (pixel, sample, dimension) has the same float32
-bits from the OpenCL kernels (kernels/baselines.cl, the GENERATE_BASELINE
+bits from the OpenCL kernels (kernels/include/pyoa/baselines.h, the GENERATE_BASELINE
 kernels of kernels/generate.cl), NumPy (pyoa/_numpy/baselines.py) and the
 pure-Python reference (pyoa/reference/baselines.py), in any batch, order or
 chunking. The ``backend`` fixture runs a test for "numpy" and "opencl".
@@ -588,12 +588,12 @@ def test_unscrambled_sets_whole(name, spp, dims):
 TEST_KERNELS = r"""
 __kernel void tb_helpers(__global const uint *x, __global const uint *seed, __global uint *rev, __global uint *lk,
                          __global uint *owen, __global float *u24)
-{ size_t g = get_global_id(0); rev[g] = reverse_bits(x[g]); lk[g] = laine_karras(x[g], seed[g]);
-  owen[g] = owen_scramble(x[g], seed[g]); u24[g] = unit24(x[g]); }
+{ size_t g = get_global_id(0); rev[g] = pyoa_reverse_bits(x[g]); lk[g] = pyoa_laine_karras(x[g], seed[g]);
+  owen[g] = pyoa_owen_scramble(x[g], seed[g]); u24[g] = pyoa_unit24(x[g]); }
 
 __kernel void tb_sobol_bits(__global const uint *g, __global const uint *dim, __global const uint *V,
                             __global uint *out)
-{ size_t k = get_global_id(0); out[k] = sobol_bits(g[k], V + 32u * dim[k]); }
+{ size_t k = get_global_id(0); out[k] = pyoa_sobol_bits(g[k], V + 32u * dim[k]); }
 
 __kernel void tb_sample(__global const uint *i, __global const uint *j, __global const uint *p, const uint which,
                         const uint a, const uint b, const float J, __global const uint *table, __global float *out)
@@ -601,12 +601,12 @@ __kernel void tb_sample(__global const uint *i, __global const uint *j, __global
     size_t g = get_global_id(0);
     uint ii = i[g], jj = j[g], pp = p[g];
     float x;
-    if (which == 0u)      x = sample_random(ii, jj, pp);
-    else if (which == 1u) x = sample_jittered2d(ii, jj, a, b, pp, J);
-    else if (which == 2u) x = sample_cmj2d(ii, jj, a, b, pp, J);
-    else if (which == 3u) x = sample_sobol02(ii, jj, a, pp, table);
-    else if (which == 4u) x = sample_halton(ii, jj, pp, table);
-    else                  x = sample_sobol(ii, jj, pp, table);
+    if (which == 0u)      x = pyoa_sample_random(ii, jj, pp);
+    else if (which == 1u) x = pyoa_sample_jittered2d(ii, jj, a, b, pp, J);
+    else if (which == 2u) x = pyoa_sample_cmj2d(ii, jj, a, b, pp, J);
+    else if (which == 3u) x = pyoa_sample_sobol02(ii, jj, a, pp, table);
+    else if (which == 4u) x = pyoa_sample_halton(ii, jj, pp, table);
+    else                  x = pyoa_sample_sobol(ii, jj, pp, table);
     out[g] = x;
 }
 """

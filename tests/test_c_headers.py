@@ -157,9 +157,10 @@ def test_permute_and_block_row_match_the_reference(lib, cases):
 def test_seeds_and_randfloat_match_the_reference(lib, cases):
     cases = cases + [(0, 0, 0), (U32, U32, U32), (0, 1, 0), (U32, 0, 1)]
     a, b, key = (u32(c) for c in zip(*cases))
-    out, order = call(lib, "t_seeds", a, b, key, out_dtypes=(np.uint32, np.uint32), out_shapes=(4 * len(a), None))
-    want = [[rh.mix32(x), rh.hash_pair(x, y, k), rh.pixel_seed(x, y), rh.block_seed(x, y)] for x, y, k in cases]
-    assert out.reshape(-1, 4).tolist() == want
+    out, order = call(lib, "t_seeds", a, b, key, out_dtypes=(np.uint32, np.uint32), out_shapes=(5 * len(a), None))
+    want = [[rh.mix32(x), rh.hash_pair(x, y, k), rh.pixel_seed(x, y), rh.block_seed(x, y), rh.frame_seed(x, y)]
+            for x, y, k in cases]
+    assert out.reshape(-1, 5).tolist() == want
     assert order.tolist() == [rh.block_order_seed(x, y, k) for x, y, k in cases]
     (r,) = call(lib, "t_randfloat", a, b, out_dtypes=(np.float32,))
     assert bits(r).tolist() == bits([rh.randfloat(x, y) for x, y, _ in cases]).tolist()

@@ -92,26 +92,35 @@ def test_register_refuses_a_taken_name_or_code():
         ct.register(clash)
     assert "clash" not in ct.REGISTRY
     bare = type("Bare", (bose,), {"name": "bare", "code": 999, "kernel": ""})
-    with pytest.raises(TypeError, match="OpenCL expression"):
+    with pytest.raises(TypeError, match="C function in the headers"):
         ct.register(bare)
 
 
-def test_dispatch_is_generated_from_the_catalogue():
-    from pyoa._opencl import program
-
-    text = program.dispatch_source()
-    for c in ENTRIES:
-        if c.family == "oa":
-            assert f"case CONSTRUCTION_{c.function.upper()}: {c.kernel}; break;" in text
-        else:
-            assert f"GENERATE_BASELINE({c.function}, {c.kernel})" in text
-    assert "default: return NAN;" in text
-    # one block rule and one tail for every construction
-    assert text.count("oa_locate(") == 1 and text.count("return oa_tail(") == 1
-    # generate.cl itself names no construction
+def test_every_entry_names_a_header_function_its_dispatch_calls():
+    """An entry's ``kernel`` names its C function in the portable headers;
+    the header's dispatch (pyoa_oa_value in oa.h, pyoa_baseline_value in
+    values.h) calls it under the entry's code, keys.h defines that code
+    from the catalogue, and generate.cl has the entry's kernel. A new entry
+    without all four fails here."""
+    include = ROOT / "kernels" / "include" / "pyoa"
+    headers = "\n".join(p.read_text() for p in sorted(include.glob("*.h")))
+    oa = (include / "oa.h").read_text()
+    values = (include / "values.h").read_text()
+    keys = (include / "keys.h").read_text()
     gen = (ROOT / "kernels" / "generate.cl").read_text()
-    assert not re.search(r"CONSTRUCTION_[A-Z]", gen)
-    assert f"-DCONSTRUCTION_BOSE={catalogue.get('bose').code}" in program.defines()
+    for c in ENTRIES:
+        code = f"PYOA_SAMPLER_{c.function.upper()}"
+        assert re.search(rf"#define {code} {c.code}u\b", keys), c.name
+        assert re.search(rf"PYOA_FN \w+ {c.kernel}\(", headers), f"{c.kernel} is not a header function"
+        if c.family == "oa":
+            assert re.search(rf"case {code}: {c.kernel}\(", re.sub(r"\s+", " ", oa)), c.name
+        else:
+            assert re.search(rf"case {code}: return {c.kernel}\(", values), c.name
+            assert f"GENERATE_BASELINE({c.function}, {code})" in gen, c.name
+    # one block rule and one tail for every construction, and nothing per
+    # construction left in the OpenCL sources
+    assert oa.count("pyoa_oa_locate(p,") == 1 and oa.count("return pyoa_oa_tail(") == 1
+    assert not re.search(r"pyoa_\w+_cell\(", gen)
 
 
 def test_an_unregistered_code_gives_nan(opencl):
@@ -124,7 +133,7 @@ __kernel void t_dispatch(__global const uint *code, __global const ushort *gf, _
                          __global float *out)
 {
     uint g = get_global_id(0);
-    out[g] = oa_dispatch(code[g], 3u, 1u, 5u, 2u, 6u, 25u, 5u, 12345u, OFFSET_CMJ, 1.0f, gf, 0u, consts);
+    out[g] = pyoa_oa_value(code[g], 3u, 1u, 5u, 2u, 6u, 25u, 5u, 12345u, PYOA_OFFSET_CMJ, 1.0f, gf, 0u, consts);
 }
 """)
     codes = np.array([catalogue.get("cmjnd").code, catalogue.get("bose").code, 999, 0xFFFFFFFF], np.uint32)

@@ -1,6 +1,6 @@
 """``faure``: Owen-scrambled Faure (0, s)-sequences in a prime base
 (pyoa/progressive.py, pyoa/reference/faure.py, pyoa/_numpy/faure.py,
-kernels/faure.cl), exactly.
+kernels/include/pyoa/faure.h), exactly.
 
 - Nets: every aligned block of ``b**m`` samples of a pixel is a (0, m, b)-net
   in base ``b``, in every block of ``b`` dimensions (block 0 and the
@@ -422,7 +422,7 @@ __kernel void tf_faure(__global const uint *i, __global const uint *j, __global 
                        __global const uint *n, __global const uint *p, __global float *out)
 {
     size_t g = get_global_id(0);
-    out[g] = sample_faure(i[g], j[g], b[g], n[g], p[g]);
+    out[g] = pyoa_sample_faure(i[g], j[g], b[g], n[g], p[g]);
 }
 """
 

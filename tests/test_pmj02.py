@@ -1,6 +1,6 @@
 """pmj02: the table (pyoa.pmj02_tables), its builders and cache, and the sampler
 values of the three backends (pyoa.reference.pmj02, pyoa._numpy.pmj02,
-kernels/pmj02.cl).
+kernels/include/pyoa/pmj02.h).
 
 Every check of stratification is exact and integer: table coordinates and
 sampler values are ``k * 2**-24`` with 24-bit ``k``, so the elementary
@@ -147,11 +147,11 @@ def test_keys_are_in_the_generated_header():
 
 
 def test_kernel_constants_match_python():
-    text = resources.files("pyoa.kernels").joinpath("pmj02.cl").read_text()
-    defined = dict(re.findall(r"^#define\s+(PMJ02_\w+)\s+(\d+)u\s*$", text, re.MULTILINE))
+    text = resources.files("pyoa.kernels").joinpath("include", "pyoa", "pmj02.h").read_text()
+    defined = dict(re.findall(r"^#define\s+PYOA_(PMJ02_\w+)\s+(\d+)u\s*$", text, re.MULTILINE))
     assert defined == {"PMJ02_SETS": str(T.SETS), "PMJ02_POINTS": str(T.POINTS)}
     assert "h >> 28" in text
-    # the keys come from -D options only (their single definition is Python's)
+    # the keys come from keys.h only (their single definition is Python's)
     assert not re.search(r"^#define\s+PMJ02_(SHIFT_)?KEY\b", text, re.MULTILINE)
 
 
@@ -470,7 +470,7 @@ def test_reference_argument_errors(args, what):
 TEST_KERNELS = r"""
 __kernel void tp_pmj02(__global const uint *i, __global const uint *j, __global const uint *p,
                        __global const uint *table, __global float *out)
-{ size_t g = get_global_id(0); out[g] = sample_pmj02(i[g], j[g], p[g], table); }
+{ size_t g = get_global_id(0); out[g] = pyoa_sample_pmj02(i[g], j[g], p[g], table); }
 """
 
 

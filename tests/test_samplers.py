@@ -248,7 +248,7 @@ def test_valid_spp_index2():
 
 def test_addelman_kempthorne_kernel_constants_layout():
     """What the kernels read for Addelman-Kempthorne: [kappa, b[0..q), k[0..q), c[0..q)]
-    (kernels/oa.cl indexes ak[1 + m], ak[1 + q + m], ak[1 + 2q + m]); nothing for the others."""
+    (pyoa/oa.h indexes ak[1 + m], ak[1 + q + m], ak[1 + 2q + m]); nothing for the others."""
     from pyoa import catalogue as constructions, gf
 
     for q in (3, 27, 243, 2887):

@@ -1,5 +1,5 @@
 """pbrt-v4's ZSobol sampler (pyoa/reference/zsobol.py, pyoa/_numpy/zsobol.py,
-kernels/zsobol.cl): the three give the same float32 bits, the permuted
+kernels/include/pyoa/zsobol.h): the three give the same float32 bits, the permuted
 indices of a pixel are an aligned block of ``N`` consecutive integers
 (disjoint between pixels, a bijection for a square power-of-two image), and
 every pixel's samples of a pair are a (0,k,2)-net, exactly.
@@ -96,7 +96,7 @@ def test_mix64():
 
 def test_sobol_dimensions_0_and_1_have_32_direction_numbers():
     """Why only ``g mod 2**32`` matters: dimensions 0 and 1 have 32 direction
-    numbers (index bits 0..31); also the recurrences kernels/zsobol.cl uses
+    numbers (index bits 0..31); also the recurrences pyoa/zsobol.h uses
     instead of a table (dimension 0: bit reversal; dimension 1: Pascal's
     triangle mod 2, v_(k+1) = v_k ^ (v_k >> 1))."""
     V = sequences.sobol_matrices()
@@ -378,8 +378,8 @@ __kernel void tz_sample(__global const uint *i, __global const uint *j, __global
                         __global const uint *seed, __global float *out, __global uint *index)
 {
     size_t g = get_global_id(0);
-    out[g] = sample_zsobol(i[g], j[g], log2n[g], log2res[g], width[g], pixel[g], seed[g]);
-    index[g] = zsobol_index(i[g], log2n[g], log2res[g], width[g], pixel[g],
+    out[g] = pyoa_sample_zsobol(i[g], j[g], log2n[g], log2res[g], width[g], pixel[g], seed[g]);
+    index[g] = pyoa_zsobol_index(i[g], log2n[g], log2res[g], width[g], pixel[g],
                             pyoa_hash_pair(seed[g], j[g] >> 1, PYOA_ZSOBOL_KEY));
 }
 
@@ -387,10 +387,10 @@ __kernel void tz_helpers(__global const uint *a, __global const uint *b, __globa
                          __global uint *morton, __global ulong *mix, __global uint *sob)
 {
     size_t g = get_global_id(0);
-    perm[g] = zsobol_perm(a[g] % 24u, b[g] & 3u);
-    morton[g] = morton2(a[g] & 0xffffu, b[g] & 0xffffu);
-    mix[g] = mix64(((ulong)a[g] << 32) | b[g]);
-    sob[g] = zsobol_sobol_bits(a[g], b[g] & 1u);
+    perm[g] = pyoa_zsobol_perm(a[g] % 24u, b[g] & 3u);
+    morton[g] = pyoa_morton2(a[g] & 0xffffu, b[g] & 0xffffu);
+    mix[g] = pyoa_mix64(((ulong)a[g] << 32) | b[g]);
+    sob[g] = pyoa_zsobol_sobol_bits(a[g], b[g] & 1u);
 }
 """
 

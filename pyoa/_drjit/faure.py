@@ -1,5 +1,5 @@
 """The Owen-scrambled Faure sequence in Dr.Jit operations (mirrors
-:func:`pyoa._numpy.faure.faure` and ``kernels/faure.cl``; the mathematics is
+:func:`pyoa._numpy.faure.faure` and ``kernels/include/pyoa/faure.h``; the mathematics is
 in :mod:`pyoa.reference.faure` and docs/spec.md section 5.11).
 
 ``b`` (the base) and ``n`` (the digits of the largest index) are Python ints:

@@ -1,5 +1,5 @@
 """Orthogonal-array samplers in Dr.Jit operations (mirrors :mod:`pyoa._numpy.oa`
-and ``kernels/oa.cl`` piece by piece; the mathematics is in :mod:`pyoa.reference.oa`
+and ``kernels/include/pyoa/oa.h`` piece by piece; the mathematics is in :mod:`pyoa.reference.oa`
 and docs/spec.md sections 4 to 6).
 
 Each sampler takes ``UInt32`` arrays of sample indices ``i``, dimensions ``j``

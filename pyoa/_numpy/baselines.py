@@ -1,5 +1,5 @@
 """The comparison samplers over NumPy arrays (mirrors :mod:`pyoa.reference.baselines`
-operation for operation, and ``kernels/baselines.cl``).
+operation for operation, and ``kernels/include/pyoa/baselines.h``).
 
 Arguments broadcast: sample indices ``i``, dimensions ``j`` and seeds ``p``
 are uint32 arrays; parameters assumed valid (the catalogue checked them).

@@ -1,6 +1,6 @@
 """The Owen-scrambled Faure sequence over NumPy arrays (mirrors
 :func:`pyoa.reference.faure.faure` operation for operation, and
-``kernels/faure.cl``).
+``kernels/include/pyoa/faure.h``).
 
 Arguments broadcast: sample indices ``i``, dimensions ``j`` and seeds ``p``
 are uint32 arrays; ``b`` and ``n`` are ints, assumed valid (the catalogue

@@ -1,5 +1,5 @@
 """Orthogonal-array samplers over NumPy arrays (mirrors :mod:`pyoa.reference.oa`
-and, piece by piece, ``kernels/oa.cl``).
+and, piece by piece, ``kernels/include/pyoa/oa.h``).
 
 Each function takes broadcastable arrays of sample indices ``i``, dimensions
 ``j`` (any ``j >= 0``; blocks per docs/spec.md section 6) and array seeds ``p`` and

@@ -1,5 +1,5 @@
 """pmj02 over NumPy arrays (mirrors :func:`pyoa.reference.pmj02.pmj02`
-operation for operation, and ``kernels/pmj02.cl``).
+operation for operation, and ``kernels/include/pyoa/pmj02.h``).
 
 Arguments broadcast: sample indices ``i``, dimensions ``j`` and seeds ``p``
 are uint32 arrays; parameters assumed valid (``i < 2**log2n <= 2**16``).

@@ -1,5 +1,5 @@
 """pbrt-v4's ZSobol sampler over NumPy arrays (mirrors :mod:`pyoa.reference.zsobol`,
-which holds the mathematics and references, and ``kernels/zsobol.cl``).
+which holds the mathematics and references, and ``kernels/include/pyoa/zsobol.h``).
 
 Sample indices ``i``, dimensions ``j`` (or pairs ``b``) and pixels broadcast
 as integer arrays (uint32 or int64 with uint32 values); ``log2n``,

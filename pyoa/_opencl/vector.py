@@ -354,7 +354,7 @@ def kernels(context, info, shp: Shape | BaselineShape) -> tuple:
             try:
                 with program._captured_stderr() as printed:
                     prg = cl.Program(context, shp.header() + program.source(kernel_sources.VECTOR_SOURCES)).build(
-                        options=program.BUILD_OPTIONS + program.defines())
+                        options=program.BUILD_OPTIONS)
             except cl.Error as exc:
                 noise = "".join(printed)
                 raise program.BuildError(info, "build", str(exc) + (f"\n{noise}" if noise.strip() else "")) from exc

@@ -28,6 +28,8 @@ PIXEL_KEY = 0x5BD1E995
 BLOCK_KEY = 0x1B873593
 #: Key of the sample order of each block past the first (docs/spec.md section 6).
 BLOCK_ORDER_KEY = 0x94D049BB
+#: Key of the seed of each frame of an animation past the first (docs/spec.md section 3.5).
+FRAME_KEY = 0x7F4A7C15
 
 
 def walk_mask(l: int) -> int:
@@ -148,6 +150,15 @@ def pixel_seed(seed: int, pixel: int) -> int:
     one user seed, distinct pixels get distinct seeds.
     """
     return hash_pair(seed, pixel, PIXEL_KEY)
+
+
+def frame_seed(seed: int, frame: int) -> int:
+    """The user seed of frame ``frame`` of an animation rendered with user seed
+    ``seed`` (docs/spec.md section 3.5): ``seed`` itself for frame 0, so a
+    still image keeps its values, else ``hash_pair(seed, frame, 0x7f4a7c15)``,
+    an independent randomization per frame. The C headers' twin is
+    ``pyoa_frame_seed`` (pyoa/hashes.h), which renderers call."""
+    return hash_pair(seed, frame, FRAME_KEY) if frame else seed
 
 
 def block_seed(p: int, block: int) -> int:

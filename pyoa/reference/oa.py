@@ -12,7 +12,7 @@ Dimensions past a block of ``B`` columns come from independently
 randomized copies of the array, each read in its own sample order
 (docs/spec.md section 6, :func:`~.hashes.locate`).
 
-Each sampler is split like ``pyoa._numpy.oa`` and ``kernels/oa.cl``: a
+Each sampler is split like ``pyoa._numpy.oa`` and ``kernels/include/pyoa/oa.h``: a
 ``*_cell`` function gives the integer cell of row ``row`` in column ``col``
 (``A_ij`` and the sub-stratum index ``u``; for Bose the partner entry
 ``A_ik``), and one shared frame, :func:`oa_value`, applies the block rule

@@ -8,7 +8,7 @@ the per-pixel errors are negatively correlated and the error image is blue
 noise, while each pixel alone keeps a (0,k,2)-net. pbrt-v4 [2]_ computes the
 sample index of a (pixel, sample) pair without any table; this module is that
 computation with pyoa's hashes (the NumPy mirror is
-:mod:`pyoa._numpy.zsobol`, the OpenCL one ``kernels/zsobol.cl``).
+:mod:`pyoa._numpy.zsobol`, the C one ``kernels/include/pyoa/zsobol.h``).
 
 **The Morton index.** A ``W x H`` image (``1 <= W, H <= 2**16``) numbers its
 pixels row-major, ``pixel = y W + x``. Each pixel has ``N = 2**k`` samples

@@ -1,6 +1,6 @@
-"""The OpenCL C functions of kernels/*.cl, called one by one through a small test
-kernel built with pyoa's own source and build options, against the C oracle.
-The orthogonal arrays are called through ``oa_dispatch`` (the block rule, the
+"""The header functions (kernels/include/pyoa) as OpenCL compiles them, called one by
+one through a small test kernel built with pyoa's own source and build options,
+against the C oracle. The orthogonal arrays are called through ``pyoa_oa_value`` (the block rule, the
 construction's cell and the common tail), with each construction's B, N and
 M written out here from docs/spec.md section 1.4."""
 
@@ -37,30 +37,30 @@ __kernel void t_bose(__global const uint *i, __global const uint *j, const uint 
                      const uint offset, const float J, __global float *out)
 { size_t g = get_global_id(0);
   /* prime s only (the C oracle's domain): tabled = 0, so the GF placeholder is never used */
-  out[g] = oa_dispatch(CONSTRUCTION_BOSE, i[g], j[g], s, 2u, s + 1u, s * s, s, p[g], offset, J,
+  out[g] = pyoa_oa_value(PYOA_SAMPLER_BOSE, i[g], j[g], s, 2u, s + 1u, s * s, s, p[g], offset, J,
                        (__global const ushort *)p, 0u, p); }
 
 __kernel void t_cmjnd(__global const uint *i, __global const uint *j, const uint s, const uint t,
                       __global const uint *p, const uint offset, const float J, __global float *out)
 { size_t g = get_global_id(0);
-  out[g] = oa_dispatch(CONSTRUCTION_CMJND, i[g], j[g], s, t, t, pow_u(s, t), pow_u(s, t - 1u), p[g], offset, J,
+  out[g] = pyoa_oa_value(PYOA_SAMPLER_CMJND, i[g], j[g], s, t, t, pyoa_pow_u(s, t), pyoa_pow_u(s, t - 1u), p[g], offset, J,
                        (__global const ushort *)p, 0u, p); }
 
 __kernel void t_gf(__global const uint *a, __global const uint *b, const uint q, __global const ushort *gf,
                    const uint tabled, __global uint *sum, __global uint *prod)
-{ size_t g = get_global_id(0); sum[g] = gf_add(a[g], b[g], q, gf, tabled); prod[g] = gf_mul(a[g], b[g], q, gf, tabled); }
+{ size_t g = get_global_id(0); sum[g] = pyoa_gf_add(a[g], b[g], q, gf, tabled); prod[g] = pyoa_gf_mul(a[g], b[g], q, gf, tabled); }
 
 __kernel void t_bose_gf(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
                         const uint offset, const float J, __global const ushort *gf, const uint tabled,
                         __global float *out)
 { size_t g = get_global_id(0);
-  out[g] = oa_dispatch(CONSTRUCTION_BOSE, i[g], j[g], s, 2u, s + 1u, s * s, s, p[g], offset, J, gf, tabled, p); }
+  out[g] = pyoa_oa_value(PYOA_SAMPLER_BOSE, i[g], j[g], s, 2u, s + 1u, s * s, s, p[g], offset, J, gf, tabled, p); }
 
 __kernel void t_bush(__global const uint *i, __global const uint *j, const uint s, const uint t,
                      __global const uint *p, const uint offset, const float J, __global const ushort *gf,
                      const uint tabled, __global float *out)
 { size_t g = get_global_id(0);
-  out[g] = oa_dispatch(CONSTRUCTION_BUSH, i[g], j[g], s, t, s + 1u, pow_u(s, t), pow_u(s, t - 1u), p[g], offset, J,
+  out[g] = pyoa_oa_value(PYOA_SAMPLER_BUSH, i[g], j[g], s, t, s + 1u, pyoa_pow_u(s, t), pyoa_pow_u(s, t - 1u), p[g], offset, J,
                        gf, tabled, p); }
 
 __kernel void t_addelman_kempthorne(__global const uint *i, __global const uint *j, const uint s,
@@ -68,24 +68,24 @@ __kernel void t_addelman_kempthorne(__global const uint *i, __global const uint 
                                     __global const ushort *gf, const uint tabled, __global const uint *ak,
                                     __global float *out)
 { size_t g = get_global_id(0);
-  out[g] = oa_dispatch(CONSTRUCTION_ADDELMAN_KEMPTHORNE, i[g], j[g], s, 2u, 2u * s + 1u, 2u * s * s, 2u * s, p[g],
+  out[g] = pyoa_oa_value(PYOA_SAMPLER_ADDELMAN_KEMPTHORNE, i[g], j[g], s, 2u, 2u * s + 1u, 2u * s * s, 2u * s, p[g],
                        offset, J, gf, tabled, ak); }
 
 __kernel void t_bose_bush(__global const uint *i, __global const uint *j, const uint s, __global const uint *p,
                           const uint offset, const float J, __global const ushort *gf, const uint tabled,
                           __global float *out)
 { size_t g = get_global_id(0);
-  out[g] = oa_dispatch(CONSTRUCTION_BOSE_BUSH, i[g], j[g], s, 2u, 2u * s + 1u, 2u * s * s, 2u * s, p[g], offset, J,
+  out[g] = pyoa_oa_value(PYOA_SAMPLER_BOSE_BUSH, i[g], j[g], s, 2u, 2u * s + 1u, 2u * s * s, 2u * s, p[g], offset, J,
                        gf, tabled, p); }
 
 __kernel void t_ak_cell(__global const uint *i, __global const uint *j, const uint q, __global const ushort *gf,
                         const uint tabled, __global const uint *ak, __global uint *aij, __global uint *u)
-{ size_t g = get_global_id(0); uint a, b; addelman_kempthorne_cell(i[g], j[g], q, gf, tabled, ak, &a, &b);
+{ size_t g = get_global_id(0); uint a, b, ck; pyoa_addelman_kempthorne_cell(i[g], j[g], q, 2u, 2u * q, gf, tabled, ak, &a, &b, &ck);
   aij[g] = a; u[g] = b; }
 
 __kernel void t_bb_cell(__global const uint *i, __global const uint *j, const uint s, __global const ushort *gf,
                         const uint tabled, __global uint *aij, __global uint *u)
-{ size_t g = get_global_id(0); uint a, b; bose_bush_cell(i[g], j[g], s, gf, tabled, &a, &b); aij[g] = a; u[g] = b; }
+{ size_t g = get_global_id(0); uint a, b, ck; pyoa_bose_bush_cell(i[g], j[g], s, 2u, 2u * s, gf, tabled, 0, &a, &b, &ck); aij[g] = a; u[g] = b; }
 """
 
 
@@ -203,7 +203,7 @@ def field_args(opencl):
 
 @pytest.mark.parametrize("q", [4, 8, 9, 27, 125, 256, 2, 13, 251, 4093])
 def test_gf_add_mul_match_pyoa_gf(harness, field_args, q):
-    """kernels/gf.cl: table lookups for prime powers, mod q for primes, on every pair
+    """pyoa/gf.h: table lookups for prime powers, mod q for primes, on every pair
     (or many random ones), against pyoa.gf's scalar definition."""
     from pyoa import gf
 
@@ -283,7 +283,7 @@ def _index2_rows_cols(s, n, rng):
 
 @pytest.mark.parametrize("offset", ["centered", "j", "mj", "cmj"])
 def test_index2_kernels_match_reference_including_seed_zero(harness, field_args, ak_consts, offset):
-    """kernels/oa.cl addelman_kempthorne (GF(q) tables for 9, 27, 243; mod q for
+    """pyoa/oa.h addelman_kempthorne (GF(q) tables for 9, 27, 243; mod q for
     3, 7, 251, 2887) and bose_bush (GF(2s) tables, s = 2 .. 128), one value at a
     time, against the reference."""
     from pyoa import reference as ref

@@ -29,15 +29,16 @@ SHIM void t_randfloat(size_t n, const pyoa_u32 *i, const pyoa_u32 *p, float *out
     for (size_t k = 0; k < n; ++k) out[k] = pyoa_randfloat(i[k], p[k]);
 }
 
-/* seeds: out[4k..4k+3] = mix32(a), hash_pair(a, b, key), pixel_seed(a, b),
- * block_seed(a, b); block_order_seed(a, b, key) in out2[k] */
+/* seeds: out[5k..5k+4] = mix32(a), hash_pair(a, b, key), pixel_seed(a, b),
+ * block_seed(a, b), frame_seed(a, b); block_order_seed(a, b, key) in out2[k] */
 SHIM void t_seeds(size_t n, const pyoa_u32 *a, const pyoa_u32 *b, const pyoa_u32 *key, pyoa_u32 *out, pyoa_u32 *out2)
 {
     for (size_t k = 0; k < n; ++k) {
-        out[4 * k + 0] = pyoa_mix32(a[k]);
-        out[4 * k + 1] = pyoa_hash_pair(a[k], b[k], key[k]);
-        out[4 * k + 2] = pyoa_pixel_seed(a[k], b[k]);
-        out[4 * k + 3] = pyoa_block_seed(a[k], b[k]);
+        out[5 * k + 0] = pyoa_mix32(a[k]);
+        out[5 * k + 1] = pyoa_hash_pair(a[k], b[k], key[k]);
+        out[5 * k + 2] = pyoa_pixel_seed(a[k], b[k]);
+        out[5 * k + 3] = pyoa_block_seed(a[k], b[k]);
+        out[5 * k + 4] = pyoa_frame_seed(a[k], b[k]);
         out2[k] = pyoa_block_order_seed(a[k], b[k], key[k]);
     }
 }

@@ -33,7 +33,11 @@
 #pragma OPENCL FP_CONTRACT OFF
 typedef uint pyoa_u32;
 typedef ushort pyoa_u16;
+typedef ulong pyoa_u64;
 #define PYOA_FN static inline
+#define PYOA_GLOBAL __global
+#define PYOA_MIN(a, b) min(a, b)
+#define PYOA_MAX(a, b) max(a, b)
 #define PYOA_AS_F32(u) as_float(u)
 #define PYOA_AS_U32(f) as_uint(f)
 #define PYOA_U32_TO_F32(u) convert_float_rte(u)
@@ -54,6 +58,14 @@ typedef ushort pyoa_u16;
 #endif
 typedef uint32_t pyoa_u32;
 typedef uint16_t pyoa_u16;
+typedef uint64_t pyoa_u64;
+/* The address space of the tables the value functions read: OpenCL's
+ * __global, nothing elsewhere (a CUDA caller passes device pointers). */
+#define PYOA_GLOBAL
+/* min and max of two unsigned integers (OpenCL's built-ins there); the
+ * arguments are evaluated twice. */
+#define PYOA_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define PYOA_MAX(a, b) ((a) > (b) ? (a) : (b))
 
 #if defined(FLT_EVAL_METHOD) && (FLT_EVAL_METHOD == 1 || FLT_EVAL_METHOD == 2) && !defined(__CUDA_ARCH__)
 #error "pyoa: float expressions here are evaluated in a wider format (FLT_EVAL_METHOD 1 or 2, x87); build with SSE2 (-msse2 -mfpmath=sse)"
@@ -73,6 +85,9 @@ typedef uint16_t pyoa_u16;
 #else
 #define PYOA_FN static inline
 #endif
+/* Functions that run on the host only: making a sampler, filling its
+ * tables (they may loop long and write to caller-owned memory). */
+#define PYOA_HOST_FN static inline
 
 PYOA_FN float pyoa_as_f32(pyoa_u32 u)
 {

@@ -85,6 +85,15 @@ PYOA_DEFINE_PERMUTE_ROUND(, pyoa_u32)
 PYOA_DEFINE_RANDFLOAT(, pyoa_u32, float, PYOA_U32_TO_F32)
 PYOA_DEFINE_SEEDS(, pyoa_u32)
 
+/* The user seed of frame `frame` of an animation rendered with user seed
+ * `seed` (spec 3.5): the seed itself for frame 0 (a still image keeps its
+ * values), else hash_pair(seed, frame, FRAME_KEY), an independent
+ * randomization per frame. */
+PYOA_FN pyoa_u32 pyoa_frame_seed(pyoa_u32 seed, pyoa_u32 frame)
+{
+    return frame ? pyoa_hash_pair(seed, frame, PYOA_FRAME_KEY) : seed;
+}
+
 /* w = the all-ones mask just covering l - 1 (the walk's domain [0, w]). */
 PYOA_FN pyoa_u32 pyoa_walk_mask(pyoa_u32 l)
 {

@@ -11,6 +11,7 @@
 #define PYOA_FAURE_DIGIT_KEY 0xa54ff53au
 #define PYOA_FAURE_INDEX_KEY 0x1f83d9abu
 #define PYOA_FAURE_KEY 0x3c6ef372u
+#define PYOA_FRAME_KEY 0x7f4a7c15u
 #define PYOA_HALTON_KEY 0x27d4eb2fu
 #define PYOA_JITTER_KEY 0x02e5be93u
 #define PYOA_JITX_KEY 0x967a889bu
@@ -30,5 +31,25 @@
 #define PYOA_SUBX_KEY 0x68bc21ebu
 #define PYOA_SUBY_KEY 0x02e5be93u
 #define PYOA_ZSOBOL_KEY 0xb5297a4du
+
+/* The catalogue's codes (pyoa.catalogue: each sampler's `code`; pyoa.catalogue_types.OFFSET_CODES). */
+#define PYOA_SAMPLER_BOSE 0u
+#define PYOA_SAMPLER_BUSH 2u
+#define PYOA_SAMPLER_CMJND 1u
+#define PYOA_SAMPLER_ADDELMAN_KEMPTHORNE 3u
+#define PYOA_SAMPLER_BOSE_BUSH 4u
+#define PYOA_SAMPLER_RANDOM 5u
+#define PYOA_SAMPLER_JITTERED2D 6u
+#define PYOA_SAMPLER_CMJ2D 7u
+#define PYOA_SAMPLER_SOBOL02 8u
+#define PYOA_SAMPLER_HALTON 9u
+#define PYOA_SAMPLER_SOBOL 10u
+#define PYOA_SAMPLER_ZSOBOL 11u
+#define PYOA_SAMPLER_PMJ02 12u
+#define PYOA_SAMPLER_FAURE 13u
+#define PYOA_OFFSET_CENTERED 0u
+#define PYOA_OFFSET_J 1u
+#define PYOA_OFFSET_MJ 2u
+#define PYOA_OFFSET_CMJ 3u
 
 #endif /* PYOA_KEYS_H */
