@@ -11,8 +11,11 @@
  *   PYOA_ADD, PYOA_SUB, PYOA_MUL and PYOA_DIV. In CUDA device code they are
  *   the round-to-nearest intrinsics (__fadd_rn, ...), which nvcc never
  *   contracts into an FMA and whose division is correctly rounded whatever
- *   --fmad, --prec-div or --use_fast_math say; elsewhere they are the plain
- *   operators, with contraction switched off below;
+ *   --fmad, --prec-div or --use_fast_math say (--use_fast_math's
+ *   --ftz=true still flushes subnormal results to zero, which pyoa's
+ *   values meet only through a jitter amount below about 1e-28;
+ *   docs/renderers.md, CUDA); elsewhere they are the plain operators, with
+ *   contraction switched off below;
  * - contraction off: OpenCL's FP_CONTRACT pragma; clang's STDC FP_CONTRACT;
  *   GCC, whose ISO modes (-std=c99, -std=c++14) do not contract but whose
  *   GNU modes do (-ffp-contract=fast), gets the optimize pragma for the
