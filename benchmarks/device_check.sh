@@ -34,6 +34,28 @@ TESTS=${TESTS:-"tests/_opencl tests/test_conformance.py tests/test_baselines_con
 timeout "${TEST_LIMIT:-330}" python3 -m pytest -q -n 14 -p no:cacheprovider $TESTS 2>&1 \
     | tee "$OUT/conformance-gpu.log" | tail -40
 echo "pytest exit: ${PIPESTATUS[0]}"
+# The portable headers in a CUDA program (benchmarks/cuda/values.cu, built with nvcc here, or the
+# binary $CUDA_BINARY built elsewhere for this GPU and carried), every catalogue sampler bit for bit
+# against NumPy, and its rate (benchmarks/cuda_check.py; CUDA_LIMIT=0 skips it). Its exit status: 2
+# no usable GPU, 3 no nvcc.
+nvcc_bin=$(command -v nvcc || { [ -x "${CUDA_HOME:-/usr/local/cuda}/bin/nvcc" ] && echo "${CUDA_HOME:-/usr/local/cuda}/bin/nvcc"; })
+if [ -n "${CUDA_BINARY:-}" ]; then
+    cuda_args=(--binary "$CUDA_BINARY")
+elif [ -n "$nvcc_bin" ]; then
+    cuda_args=(--nvcc "$nvcc_bin")
+else
+    cuda_args=()
+fi
+if [ "${CUDA_LIMIT:-120}" = 0 ]; then
+    echo "CUDA check skipped (CUDA_LIMIT=0)"
+elif [ ${#cuda_args[@]} = 0 ]; then
+    echo "CUDA check skipped: nvcc not found (PATH, ${CUDA_HOME:-/usr/local/cuda}/bin) and no CUDA_BINARY; benchmarks/cuda_check.py needs the CUDA toolkit or a prebuilt values.cu"
+else
+    echo "CUDA check: ${cuda_args[*]}"
+    timeout "${CUDA_LIMIT:-120}" python3 benchmarks/cuda_check.py "${cuda_args[@]}" --out "$OUT" 2>&1 \
+        | tee "$OUT/cuda-check.log" | tail -25
+    echo "cuda_check exit: ${PIPESTATUS[0]}"
+fi
 [ "${BENCH_LIMIT:-90}" = 0 ] || timeout "${BENCH_LIMIT:-90}" python3 benchmarks/bench_generate.py --backends opencl --no-peers \
     --cases bose-cmj-121x10,bose-cmj-121x12,bose-cmj-121x36,bush-cmj-125x10 --repeats 9 \
     --out "$OUT/generate-gpu.json" 2>&1 | tail -20
