@@ -26,13 +26,18 @@ PYOA_FN FT pyoa_cell_floor##SFX(UT c, float nf)                                 
                                                                                         \
 /* x clamped into its cell [c/n, (c+1)/n) (spec 7.4): values inside keep their      \
  * bits, a value past an edge becomes the nearest float32 inside. Branch-free,      \
- * so that callers vectorize. */                                                    \
+ * so that callers vectorize: both comparisons are made unconditionally (a         \
+ * nested ?: compares x > hi only where x >= lo, and under GCC's default           \
+ * -ftrapping-math a comparison that may trap is then not evaluated                \
+ * speculatively: the loop keeps a branch). lo <= hi (spec 7.5), so the order      \
+ * of the two selects does not matter. */                                           \
 PYOA_FN FT pyoa_cell_clamp##SFX(FT x, UT c, pyoa_u32 n)                                 \
 {                                                                                       \
     float nf = PYOA_U32_TO_F32(n);                                                      \
     FT lo = pyoa_cell_floor##SFX(c, nf);                                                \
     FT hi = ASF(ASU(pyoa_cell_floor##SFX(c + 1u, nf)) - 1u);                            \
-    return x < lo ? lo : (x > hi ? hi : x);                                             \
+    FT below_hi = x > hi ? hi : x;                                                      \
+    return x < lo ? lo : below_hi;                                                      \
 }                                                                                       \
                                                                                         \
 /* (stratum + (sub + jitter) / M) / s (spec 1.2): four correctly rounded            \
@@ -59,8 +64,9 @@ PYOA_FN FT pyoa_centered_value##SFX(UT stratum, FT jitter, pyoa_u32 M, pyoa_u32 
 {                                                                                       \
     FT mid = (FT)PYOA_MUL(0.5f, PYOA_U32_TO_F32(M - 1u)); /* not "half": an OpenCL type */ \
     FT x = pyoa_formula_value##SFX(stratum, mid, jitter, M, s);                         \
-    pyoa_u32 odd = M & 1u;                                                              \
-    return pyoa_cell_clamp##SFX(x, odd ? stratum * M + (M - 1u) / 2u : stratum, odd ? M * s : s); \
+    pyoa_u32 cm, ch, n;                                                                 \
+    pyoa_centered_cell(M, s, &cm, &ch, &n);                                             \
+    return pyoa_cell_clamp##SFX(x, stratum * cm + ch, n);                               \
 }                                                                                       \
                                                                                         \
 /* The jitter of spec 1.2: 0.5 + amount (r - 0.5), two rounded operations and a     \
@@ -68,6 +74,20 @@ PYOA_FN FT pyoa_centered_value##SFX(UT stratum, FT jitter, pyoa_u32 M, pyoa_u32 
 PYOA_FN FT pyoa_jitter_value##SFX(FT r, float amount)                                   \
 {                                                                                       \
     return PYOA_ADD((FT)0.5f, PYOA_MUL((FT)amount, PYOA_SUB(r, (FT)0.5f)));             \
+}
+
+/* The cell the 'centered' value of a stratum is clamped into (spec 4,
+ * 7.4): cell stratum * cm + ch of n. For odd M, sub = (M-1)/2 is an
+ * integer: the fine cell stratum * M + (M-1)/2 of n = M s; for even M it
+ * is a half-integer between two fine cells: the coarse stratum of n = s.
+ * It depends on M and s alone, so a loop over strata hoists it (a select
+ * per lane kept GCC from vectorizing pyoa/fill.h's loops). */
+PYOA_FN void pyoa_centered_cell(pyoa_u32 M, pyoa_u32 s, pyoa_u32 *cm, pyoa_u32 *ch, pyoa_u32 *n)
+{
+    pyoa_u32 odd = M & 1u;
+    *cm = odd ? M : 1u;
+    *ch = odd ? (M - 1u) / 2u : 0u;
+    *n = odd ? M * s : s;
 }
 
 PYOA_DEFINE_FLOATS(, pyoa_u32, float, PYOA_U32_TO_F32, PYOA_AS_F32, PYOA_AS_U32)
