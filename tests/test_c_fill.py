@@ -64,7 +64,7 @@ def libraries(tmp_path_factory):
         tmp = tmp_path_factory.mktemp(build)
         src = tmp / f"fill_shim{suffix}"
         src.write_text(SHIM.read_text())
-        cmd = [compiler, *flags, "-shared", "-fPIC", f"-I{INCLUDE}", str(src), "-o", str(tmp / "libfill.so")]
+        cmd = [compiler, *flags, "-shared", "-fPIC", f"-I{INCLUDE}", f"-I{SHIM.parent}", str(src), "-o", str(tmp / "libfill.so")]
         procs[build] = (cmd, tmp / "libfill.so", subprocess.Popen(cmd, cwd=tmp, stdout=subprocess.PIPE,
                                                                    stderr=subprocess.PIPE, text=True))
     out = {}

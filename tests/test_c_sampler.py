@@ -47,7 +47,7 @@ def lib(request, tmp_path_factory):
     src = tmp / f"sampler_shim{suffix}"
     src.write_text(SHIM.read_text())
     so = tmp / "libsampler.so"
-    compile_(compiler, [*flags, "-shared", "-fPIC", f"-I{INCLUDE}", str(src), "-o", str(so)], tmp)
+    compile_(compiler, [*flags, "-shared", "-fPIC", f"-I{INCLUDE}", f"-I{SHIM.parent}", str(src), "-o", str(so)], tmp)
     dll = ctypes.CDLL(str(so))
     u32p = np.ctypeslib.ndpointer(np.uint32, flags="C")
     dll.t_values.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_char_p,

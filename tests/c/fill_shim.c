@@ -11,6 +11,8 @@
 
 #include <pyoa/fill.h>
 
+#include "make_sampler.h"
+
 #if defined(__cplusplus)
 #define SHIM extern "C"
 #else
@@ -35,49 +37,13 @@ SHIM int t_fill(const char *name, pyoa_u32 spp, pyoa_u32 dims, pyoa_u32 seed, co
                 pyoa_u32 pixel1, pyoa_u32 sample0, pyoa_u32 n_samples, pyoa_u32 dim0, pyoa_u32 n_dims, float *out,
                 float *want, pyoa_u32 *info, char *message, size_t message_size)
 {
-    pyoa_options o = pyoa_options_default(name, spp);
     pyoa_sampler s;
     unsigned char *scratch;
-    size_t bytes, n = (size_t)n_samples * n_dims, k;
+    size_t n = (size_t)n_samples * n_dims, k;
     pyoa_u32 i, d, modes = 0u, intact = 1u;
-    int rc;
-    o.dims = dims;
-    o.seed = seed;
-    o.offset = (offset && offset[0]) ? offset : NULL;
-    o.jitter = jitter;
-    o.strength = strength;
-    o.base = base;
-    o.width = width;
-    o.height = height;
-    rc = pyoa_sampler_make(&s, &o, message, message_size);
+    int rc = make_sampler(&s, name, spp, dims, seed, offset, jitter, strength, base, width, height, message,
+                          message_size);
     if (rc != PYOA_OK) return rc;
-    bytes = pyoa_sampler_table_bytes(&s);
-    if (s.code == PYOA_SAMPLER_PMJ02) {
-        /* pmj02's 8 MB table is the same for every pmj02 sampler: once per library */
-        static void *pmj02_table = NULL;
-        if (!pmj02_table) {
-            pmj02_table = malloc(bytes);
-            if (!pmj02_table) return -1;
-            pyoa_sampler_fill_table(&s, pmj02_table);
-        }
-        pyoa_sampler_bind_table(&s, pmj02_table);
-    } else if (bytes) {
-        /* the last table, kept while the sampler's parameters are the same
-         * (GF(256)'s tables take milliseconds, and the tests ask for many
-         * requests of one sampler in a row) */
-        static void *last = NULL;
-        static pyoa_u32 key[6];
-        pyoa_u32 now[6];
-        now[0] = s.code, now[1] = s.spp, now[2] = s.s, now[3] = s.strength, now[4] = s.dims, now[5] = s.field;
-        if (!last || memcmp(key, now, sizeof key) != 0) {
-            free(last);
-            last = malloc(bytes);
-            if (!last) return -1;
-            pyoa_sampler_fill_table(&s, last);
-            memcpy(key, now, sizeof key);
-        }
-        pyoa_sampler_bind_table(&s, last);
-    }
     info[0] = (pyoa_u32)pyoa_fill_scratch_bytes(&s, n_dims);
     scratch = (unsigned char *)malloc(info[0] + GUARD);
     if (!scratch) return -1;

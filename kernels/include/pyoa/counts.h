@@ -32,6 +32,7 @@
 #define PYOA_COUNTS_H
 
 #include "config.h"
+#include "gf.h"
 #include "keys.h"
 
 /* What pyoa_solve and the others return: 0, or the kind of argument that
@@ -247,38 +248,6 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_bit_length(pyoa_u32 v)
         n++;
     }
     return n;
-}
-
-/* constructions.is_prime */
-PYOA_HOST_FN int pyoa_counts_is_prime(pyoa_u32 n)
-{
-    pyoa_u32 d;
-    if (n < 2u)
-        return 0;
-    if (n % 2u == 0u)
-        return n == 2u;
-    for (d = 3u; (pyoa_u64)d * d <= n; d += 2u)
-        if (n % d == 0u)
-            return 0;
-    return 1;
-}
-
-/* gf.is_supported: q = p^r with p prime, and r == 1 or q <= gf.MAX_TABLE_Q
- * = 256 (the composite orders pyoa has tables for). */
-PYOA_HOST_FN int pyoa_counts_field(pyoa_u32 q)
-{
-    pyoa_u32 p = 2u, r = 0u;
-    if (q < 2u)
-        return 0;
-    while ((pyoa_u64)p * p <= q && q % p != 0u)
-        p++;
-    if (q % p != 0u)
-        return 1; /* prime */
-    while (q % p == 0u) {
-        q /= p;
-        r++;
-    }
-    return q == 1u && (r == 1u || pyoa_counts_pow(p, r) <= 256u);
 }
 
 /* -------------------------------------------------------------- the names */
@@ -498,13 +467,13 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_default_base(pyoa_u32 spp, pyoa_u32 dims)
     if (root > PYOA_COUNTS_MAX_BASE)
         root = PYOA_COUNTS_MAX_BASE;
     for (; root >= 2u; --root) {
-        if (pyoa_counts_is_prime(root)) {
+        if (pyoa_is_prime(root)) {
             b_max = root;
             break;
         }
     }
     if (dims != 0u && dims <= PYOA_COUNTS_MAX_BASE) {
-        for (fits = dims; !pyoa_counts_is_prime(fits); ++fits) {
+        for (fits = dims; !pyoa_is_prime(fits); ++fits) {
         }
         if (fits <= b_max) /* also bounds fits by MAX_BASE */
             return fits;
@@ -573,7 +542,7 @@ PYOA_HOST_FN void pyoa_counts_strengths(pyoa_u32 code, pyoa_u32 dims, pyoa_u32 s
  * accepts N = s^t (Bush: s >= t a supported field; CMJND: s >= 2). */
 PYOA_HOST_FN int pyoa_counts_power_ok(pyoa_u32 code, pyoa_u32 s, pyoa_u32 t)
 {
-    return code == PYOA_SAMPLER_BUSH ? s >= t && pyoa_counts_field(s) : s >= 2u;
+    return code == PYOA_SAMPLER_BUSH ? s >= t && pyoa_gf_is_supported(s) : s >= 2u;
 }
 
 /* Whether x is a level of an index-2 array: Addelman-Kempthorne's odd
@@ -581,7 +550,7 @@ PYOA_HOST_FN int pyoa_counts_power_ok(pyoa_u32 code, pyoa_u32 s, pyoa_u32 t)
 PYOA_HOST_FN int pyoa_counts_index2_level(pyoa_u32 code, pyoa_u32 x)
 {
     if (code == PYOA_SAMPLER_ADDELMAN_KEMPTHORNE)
-        return x >= 3u && x <= PYOA_COUNTS_AK_MAX_Q && x % 2u == 1u && pyoa_counts_field(x);
+        return x >= 3u && x <= PYOA_COUNTS_AK_MAX_Q && x % 2u == 1u && pyoa_gf_is_supported(x);
     return x >= 2u && x <= 128u && (x & (x - 1u)) == 0u;
 }
 
@@ -633,7 +602,7 @@ PYOA_HOST_FN int pyoa_counts_solve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 dims, p
             return PYOA_ERROR_STRENGTH;
         }
         s = pyoa_counts_isqrt(spp);
-        if (s * s != spp || !pyoa_counts_field(s) || s > PYOA_COUNTS_BOSE_MAX_S)
+        if (s * s != spp || !pyoa_gf_is_supported(s) || s > PYOA_COUNTS_BOSE_MAX_S)
             return -1;
         pyoa_counts_oa(out, code, s, 2u, dims);
         return 0;
@@ -701,7 +670,7 @@ PYOA_HOST_FN pyoa_u64 pyoa_counts_step_count(pyoa_u32 code, pyoa_u32 x)
 PYOA_HOST_FN int pyoa_counts_step_ok(pyoa_u32 code, pyoa_u32 x)
 {
     switch (code) {
-    case PYOA_SAMPLER_BOSE: return pyoa_counts_field(x);
+    case PYOA_SAMPLER_BOSE: return pyoa_gf_is_supported(x);
     case PYOA_SAMPLER_ADDELMAN_KEMPTHORNE: return pyoa_counts_index2_level(code, x);
     default: return 1;
     }
@@ -1205,14 +1174,14 @@ PYOA_HOST_FN int pyoa_counts_resolve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 stren
         return PYOA_ERROR_BASE;
     }
     if (base != 0u) {
-        if (base > PYOA_COUNTS_MAX_BASE || !pyoa_counts_is_prime(base)) {
+        if (base > PYOA_COUNTS_MAX_BASE || !pyoa_is_prime(base)) {
             /* the two primes closest to base (a tie to the smaller), in increasing order */
             pyoa_u32 below[2] = {0u, 0u}, above[2] = {0u, 0u}, nb = 0u, na = 0u, x, pick[2], k;
             for (x = base > PYOA_COUNTS_MAX_BASE ? PYOA_COUNTS_MAX_BASE : base - 1u; x >= 2u && nb < 2u; --x)
-                if (pyoa_counts_is_prime(x))
+                if (pyoa_is_prime(x))
                     below[nb++] = x;
             for (x = base + 1u; base < PYOA_COUNTS_MAX_BASE && x <= PYOA_COUNTS_MAX_BASE && na < 2u; ++x)
-                if (pyoa_counts_is_prime(x))
+                if (pyoa_is_prime(x))
                     above[na++] = x;
             for (k = 0u, nb = 0u, na = 0u; k < 2u; ++k) { /* merge by distance, ties to the smaller */
                 int take_below = nb < 2u && below[nb] != 0u

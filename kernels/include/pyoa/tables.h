@@ -27,10 +27,9 @@
 #define PYOA_TABLES_H
 
 #include "config.h"
+#include "gf.h"
 #include "sobol_data.h"
 
-/* The largest composite prime power with GF tables (pyoa.gf.MAX_TABLE_Q). */
-#define PYOA_GF_MAX_TABLE_Q 256u
 /* Halton's bases are the primes below 2^16 (pyoa.sequences.HALTON_MAX_BASE),
  * 6542 of them (HALTON_MAX_DIMS). */
 #define PYOA_HALTON_MAX_BASE 65536u
@@ -55,37 +54,6 @@ typedef struct pyoa_tables_field {
     pyoa_u32 q, p, r;
     pyoa_u32 f[PYOA_TABLES_MAX_R];
 } pyoa_tables_field;
-
-/* The smallest prime factor p of q >= 2 and the exponent r with q = p^r;
- * returns p, or 0 (r = 0) when q is not a prime power (q < 2 included).
- * pyoa.gf.prime_power. Trial division up to sqrt(q) < 2^16. */
-PYOA_HOST_FN pyoa_u32 pyoa_gf_prime_power(pyoa_u32 q, pyoa_u32 *r)
-{
-    pyoa_u32 p = q, d, e = 0;
-    *r = 0;
-    if (q < 2) return 0;
-    for (d = 2; d <= q / d; ++d) {
-        if (q % d == 0) {
-            p = d;
-            break;
-        }
-    }
-    while (q % p == 0) {
-        q /= p;
-        ++e;
-    }
-    if (q != 1) return 0;
-    *r = e;
-    return p;
-}
-
-/* Whether pyoa has GF(q): q prime, or a prime power up to 256
- * (pyoa.gf.is_supported). */
-PYOA_HOST_FN int pyoa_gf_is_supported(pyoa_u32 q)
-{
-    pyoa_u32 r;
-    return pyoa_gf_prime_power(q, &r) != 0 && (r == 1 || q <= PYOA_GF_MAX_TABLE_Q);
-}
 
 /* Whether GF(q) is read from tables (1: q = p^r with r >= 2 and q <= 256)
  * or computed mod q (0: q prime, and q = 0, "no field", or a q pyoa does
