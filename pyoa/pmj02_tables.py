@@ -61,7 +61,7 @@ import numpy as np
 
 from .atomic import atomic_path
 from .reference.hashes import MASK
-from .reference.pmj02 import (
+from .reference.pmj02_build import (
     BITS,
     BUILD_SEED,
     PMJ02_DRAW_KEY,

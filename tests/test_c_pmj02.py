@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 
 from pyoa import c_headers
 from pyoa import pmj02_tables as T
-from pyoa.reference import pmj02 as R
+from pyoa.reference import pmj02_build as B
 
 INCLUDE = Path(c_headers.get_include())
 SHIM = Path(__file__).parent / "c" / "pmj02_shim.c"
@@ -101,21 +101,21 @@ def fill_set(lib, s: int, points: int, scratch: np.ndarray) -> tuple[int, np.nda
 def test_constants_and_sizes_match_python(lib):
     got = np.zeros(10, np.uint32)
     lib.t_pmj02_constants(ptr(got))
-    assert got.tolist() == [R.BUILD_SEED, R.SETS, R.POINTS_LOG2, R.POINTS, R.BITS,
-                            R.X_STRATUM, R.Y_STRATUM, R.X_LOW, R.Y_LOW, R.SWAP]
+    assert got.tolist() == [B.BUILD_SEED, B.SETS, B.POINTS_LOG2, B.POINTS, B.BITS,
+                            B.X_STRATUM, B.Y_STRATUM, B.X_LOW, B.Y_LOW, B.SWAP]
     assert lib.t_pmj02_table_entries() == int(np.prod(T.SHAPE)) == 16 * 65536 * 2
     # (M + 1) * 2**M occupancy bits at the last level M = 16, packed
-    assert lib.t_pmj02_scratch_bytes() == (R.POINTS_LOG2 + 1) * R.POINTS // 8
+    assert lib.t_pmj02_scratch_bytes() == (B.POINTS_LOG2 + 1) * B.POINTS // 8
 
 
 @settings(max_examples=30, deadline=None)
 @given(st.lists(st.tuples(st.integers(0, U32), st.integers(0, U32), st.integers(0, 7), st.integers(0, 2**29 - 1)),
                 min_size=1, max_size=20))
 def test_set_seed_and_draw_match_the_reference(lib, cases):
-    sets = [c[0] for c in cases] + list(range(R.SETS))
-    assert batch(lib, "t_pmj02_set_seed", sets) == [R.set_seed(s) for s in sets]
+    sets = [c[0] for c in cases] + list(range(B.SETS))
+    assert batch(lib, "t_pmj02_set_seed", sets) == [B.set_seed(s) for s in sets]
     cases = cases + [(0, 0, 0, 0), (U32, U32, 7, 2**29 - 1)]
-    assert batch(lib, "t_pmj02_draw", *zip(*cases)) == [R.draw(*c) for c in cases]
+    assert batch(lib, "t_pmj02_draw", *zip(*cases)) == [B.draw(*c) for c in cases]
 
 
 @settings(max_examples=30, deadline=None)
@@ -123,7 +123,7 @@ def test_set_seed_and_draw_match_the_reference(lib, cases):
                 min_size=1, max_size=20))
 @example([(1, 2, 0, 1), (5, 6, 1, 2), (7, 8, 0, 3), (9, 9, 1, 2**16), (3, 4, 0, 2**15 + 1)])
 def test_uniform_index_matches_the_reference(lib, cases):
-    assert batch(lib, "t_pmj02_uniform_index", *zip(*cases)) == [R.uniform_index(*c) for c in cases]
+    assert batch(lib, "t_pmj02_uniform_index", *zip(*cases)) == [B.uniform_index(*c) for c in cases]
 
 
 # ----------------------------------------------------------------------------- the strata walk
@@ -147,7 +147,7 @@ def test_strata_walk_matches_the_reference(lib, walk, axis):
     """The depth-first walk lists the same strata in the same order as the
     reference's breadth-first chain lists, also where chains branch."""
     M, q, qa, qb, cells = walk
-    occ = R.Occupancy(M, [], [])
+    occ = B.Occupancy(M, [], [])
     occ.cells = cells
     want = occ.strata(q, qa, qb, axis)
     flat = np.concatenate([np.frombuffer(bytes(c), np.uint8) for c in cells])  # bit (u << M) | i
@@ -172,7 +172,7 @@ def test_whole_table_matches_python_bit_for_bit(lib, table):
     assert rc == 0
     assert T.table_sha256(out) == T.TABLE_SHA256
     assert np.array_equal(out, table)
-    assert int(out.max()) < 1 << R.BITS
+    assert int(out.max()) < 1 << B.BITS
 
 
 def test_fill_set_with_scratch_matches_the_table(lib, table):
@@ -180,7 +180,7 @@ def test_fill_set_with_scratch_matches_the_table(lib, table):
     would: the table's rows; and a used scratch reused gives the same bits."""
     scratch = garbage_scratch(lib)
     for s in (0, 5, 15):
-        rc, out = fill_set(lib, s, R.POINTS, scratch)
+        rc, out = fill_set(lib, s, B.POINTS, scratch)
         assert rc == 0
         assert np.array_equal(out, table[s]), s
     rc, out = fill_set(lib, 0, 1 << 12, scratch)
@@ -191,7 +191,7 @@ def test_first_points_of_set_0_match_the_reference(lib, table):
     scratch = garbage_scratch(lib)
     rc, out = fill_set(lib, 0, 1 << 10, scratch)
     assert rc == 0
-    assert [tuple(p) for p in out.tolist()] == R.build_set(0, 1 << 10)
+    assert [tuple(p) for p in out.tolist()] == B.build_set(0, 1 << 10)
     assert np.array_equal(out, table[0, :1 << 10])
 
 
@@ -204,7 +204,7 @@ def test_prefixes_of_other_sets_match_the_reference(lib, s, log2points):
     the C builder is the reference's algorithm, not only its 16 outputs."""
     rc, out = fill_set(lib, s, 1 << log2points, garbage_scratch(lib))
     assert rc == 0
-    assert [tuple(p) for p in out.tolist()] == R.build_set(s, 1 << log2points)
+    assert [tuple(p) for p in out.tolist()] == B.build_set(s, 1 << log2points)
 
 
 @pytest.mark.parametrize("points", [0, 3, 6, 1 << 17, (1 << 16) + 1, U32])

@@ -32,6 +32,7 @@ from pyoa import reference
 from pyoa._numpy import pmj02 as npmj
 from pyoa._numpy.hashes import pixel_seed
 from pyoa.reference import pmj02 as R
+from pyoa.reference import pmj02_build as B
 from pyoa.reference.hashes import hash_pair
 from tests.helpers import U32_MAX, assert_same_bits, kernel_runner
 
@@ -209,7 +210,7 @@ def test_numba_builder_equals_python_builder(table):
     points of sets 0 and 15, and the whole of set 15 (every level, 1 to 16)."""
     stats = {}
     for s, points in [(0, 2**12), (15, 2**12), (15, T.POINTS)]:
-        want = np.array(R.build_set(s, points, stats), dtype=U32)
+        want = np.array(B.build_set(s, points, stats), dtype=U32)
         assert np.array_equal(T.build(sets=[s], points=points)[0], want), (s, points)
         assert np.array_equal(table[s, :points], want), (s, points)
     assert stats == {"max_strata": 1, "redraws": 0}
@@ -226,19 +227,19 @@ def test_build_rejects_bad_sizes(points):
     with pytest.raises(ValueError, match="power of two"):
         T.build(sets=1, points=points)
     with pytest.raises(ValueError, match="power of two"):
-        R.build_set(0, points)
+        B.build_set(0, points)
 
 
 def test_dead_end_raises():
     """A subquadrant without a valid position fails loudly (it never happens
     for the table's seeds: the builds above succeed)."""
-    occ = R.Occupancy(3, [], [])
+    occ = B.Occupancy(3, [], [])
     for cells in occ.cells:
         cells[:] = b"\x01" * len(cells)
     with pytest.raises(RuntimeError, match="dead end"):
-        R.place(occ, 2, 1, 2, R.set_seed(0), 8)
+        B.place(occ, 2, 1, 2, B.set_seed(0), 8)
     # one empty chain: x strata exist, y strata do not
-    occ = R.Occupancy(1, [], [])
+    occ = B.Occupancy(1, [], [])
     occ.cells[0][:] = b"\x01\x01"
     assert occ.strata(1, 0, 0, 0) == [0]
     assert occ.strata(1, 0, 0, 1) == []
@@ -246,15 +247,15 @@ def test_dead_end_raises():
 
 def test_draws_are_counter_based():
     """The build's random numbers are hashes of (set seed, index, purpose, attempt)."""
-    seed = R.set_seed(5)
-    assert seed == hash_pair(R.BUILD_SEED, 5, R.PMJ02_BUILD_KEY)
-    assert R.draw(seed, 9, R.X_LOW, 0) == hash_pair(hash_pair(seed, 9, R.PMJ02_DRAW_KEY), R.X_LOW, R.PMJ02_DRAW_KEY)
-    values = {R.draw(seed, 9, purpose, attempt) for purpose in range(5) for attempt in range(4)}
+    seed = B.set_seed(5)
+    assert seed == hash_pair(B.BUILD_SEED, 5, B.PMJ02_BUILD_KEY)
+    assert B.draw(seed, 9, B.X_LOW, 0) == hash_pair(hash_pair(seed, 9, B.PMJ02_DRAW_KEY), B.X_LOW, B.PMJ02_DRAW_KEY)
+    values = {B.draw(seed, 9, purpose, attempt) for purpose in range(5) for attempt in range(4)}
     assert len(values) == 20
     # uniform_index: exact rejection, in range, and every value reachable
-    got = {R.uniform_index(seed, i, R.X_STRATUM, 5) for i in range(200)}
+    got = {B.uniform_index(seed, i, B.X_STRATUM, 5) for i in range(200)}
     assert got == set(range(5))
-    assert R.uniform_index(seed, 0, R.X_STRATUM, 1) == 0
+    assert B.uniform_index(seed, 0, B.X_STRATUM, 1) == 0
 
 
 # ----------------------------------------------------------------------------- the cache
