@@ -22,6 +22,8 @@ from ..atomic import atomic_path
 EXR, PNG = (".exr",), (".png",)
 #: Pixel formats of linear radiance (OpenImageIO base types).
 LINEAR_FORMATS = ("half", "float", "double")
+#: Prefix of pyoa's attributes in an image header (what they hold: :mod:`pyoa.render.provenance`).
+PREFIX = "pyoa:"
 
 
 def _oiio():
@@ -70,10 +72,8 @@ def check_finite(image: np.ndarray, what: str) -> None:
 
 
 def _write(path, pixels: np.ndarray, fmt: str, metadata: dict | None = None) -> None:
-    from .provenance import attributes
-
     oiio = _oiio()
-    attrs = attributes(metadata)  # a bad value is refused before anything is written
+    attrs = header_attributes(metadata)  # a bad value is refused before anything is written
     h, w, c = pixels.shape
 
     def failed(message: str) -> str:
@@ -97,7 +97,7 @@ def _write(path, pixels: np.ndarray, fmt: str, metadata: dict | None = None) -> 
 def write_exr(path: str | os.PathLike, image: np.ndarray, metadata: dict | None = None) -> None:
     """Write a linear float32 RGB image (``(H, W, 3)``) as OpenEXR, atomically,
     with ``metadata`` (str or int values, :func:`pyoa.render.provenance.describe`)
-    in its header as ``pyoa:KEY`` attributes (:func:`pyoa.render.provenance.read`).
+    in its header as ``pyoa:KEY`` attributes (:func:`read_attributes`).
 
     A non-finite pixel, or one a float32 cannot hold, is refused (ValueError)."""
     with np.errstate(over="ignore"):  # a value over the float32 range becomes inf, refused just below
@@ -120,7 +120,7 @@ def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
     _write(path, to_srgb8(image), "uint8")
 
 
-def _open(path, what: str = "an image pyoa reads"):
+def open_image(path, what: str = "an image pyoa reads"):
     """``path`` opened by OpenImageIO, after the regular-file check every
     file pyoa reads gets (:func:`pyoa.render.state.check_state_file`): a
     FIFO would block OpenImageIO's open for ever, a device be read for ever.
@@ -143,7 +143,7 @@ def _open(path, what: str = "an image pyoa reads"):
 def image_info(path: str | os.PathLike, what: str = "an image pyoa reads") -> tuple[int, int, int, str]:
     """``(width, height, channels, pixel format)`` of an image file, from its
     header only (nothing is decoded); ``what`` names the file in a refusal."""
-    inp = _open(path, what)
+    inp = open_image(path, what)
     try:
         spec = inp.spec()
         return spec.width, spec.height, spec.nchannels, str(spec.format)
@@ -155,7 +155,7 @@ def read_image(path: str | os.PathLike, what: str = "an image pyoa reads") -> np
     """Read an image (EXR, PNG, ...) as float32 ``(H, W, channels)``; ``what``
     names the file in a refusal. A file whose pixels cannot all be read (cut
     short, damaged) is refused with OpenImageIO's reason."""
-    inp = _open(path, what)
+    inp = open_image(path, what)
     try:
         spec = inp.spec()
         pixels = inp.read_image("float")
@@ -205,6 +205,12 @@ def read_reference(path, option: str, width: int, height: int) -> np.ndarray:
     return np.ascontiguousarray(ref)
 
 
+def default_crop(shape):
+    """The crop window of compare and study without ``--crop``: the quarter-size window at (W/4, H/4)."""
+    h, w = shape[:2]
+    return (w // 4, h // 4, max(1, w // 4), max(1, h // 4))
+
+
 def check_crop(crop, width: int, height: int) -> None:
     """Refuse (ValueError) a crop window ``(x, y, w, h)`` that is empty or not
     inside a ``width`` x ``height`` image."""
@@ -227,3 +233,24 @@ def rel_mse(image: np.ndarray, reference: np.ndarray, crop=None) -> float:
         image, reference = image[y:y + h, x:x + w], reference[y:y + h, x:x + w]
     a, r = image.astype(np.float64), reference.astype(np.float64)
     return float(np.mean((a - r) ** 2 / (r**2 + 1e-2)))
+
+
+def header_attributes(meta: dict | None) -> list[tuple[str, str | int]]:
+    """``meta`` as (header name, value) pairs: names prefixed, values str or int (others refused)."""
+    out = []
+    for key, value in (meta or {}).items():
+        if isinstance(value, bool) or not isinstance(value, (str, int)):
+            raise TypeError(f"image metadata {key!r} must be a str or an int, got {type(value).__name__}")
+        out.append((PREFIX + key, value))
+    return out
+
+
+def read_attributes(path) -> dict:
+    """The ``pyoa:`` attributes of an image's header as ``{key: value}`` (empty for an image pyoa did not
+    write, or wrote before it kept them)."""
+    inp = open_image(path)
+    try:
+        spec = inp.spec()
+        return {a.name[len(PREFIX):]: a.value for a in spec.extra_attribs if a.name.startswith(PREFIX)}
+    finally:
+        inp.close()

@@ -31,7 +31,7 @@ keeps any named attribute, as pbrt-v4 keeps its render metadata there too):
 ``pyoa:command``          the command line, when written by the CLI
 ========================  =====================================================
 
-:func:`read` gives them back as a dict (``pyoa info FILE`` prints them).
+:func:`pyoa.render.image.read_attributes` gives them back as a dict (``pyoa info FILE`` prints them).
 """
 
 from __future__ import annotations
@@ -42,10 +42,6 @@ import shlex
 import subprocess
 import unicodedata
 from pathlib import Path
-
-#: Prefix of pyoa's attributes in an image header.
-PREFIX = "pyoa:"
-
 
 @functools.lru_cache(maxsize=1)
 def git_revision() -> str:
@@ -95,16 +91,6 @@ def describe(scene, p, *, kind: str, command: str | None = None, shading: str | 
     return {k: v for k, v in meta.items() if v != ""}
 
 
-def attributes(meta: dict | None) -> list[tuple[str, str | int]]:
-    """``meta`` as (header name, value) pairs: names prefixed, values str or int (others refused)."""
-    out = []
-    for key, value in (meta or {}).items():
-        if isinstance(value, bool) or not isinstance(value, (str, int)):
-            raise TypeError(f"image metadata {key!r} must be a str or an int, got {type(value).__name__}")
-        out.append((PREFIX + key, value))
-    return out
-
-
 def printable(value) -> str:
     """``value`` as text safe to print on a terminal: control and format characters (newline, CR, ESC,
     bidirectional overrides, ...) written as their Python escapes (``\\n``, ``\\r``, ``\\x1b``,
@@ -126,16 +112,3 @@ def json_value(value):
     if isinstance(value, (tuple, list)):
         return [json_value(v) for v in value]
     return value
-
-
-def read(path) -> dict:
-    """The ``pyoa:`` attributes of an image's header as ``{key: value}`` (empty for an image pyoa did not
-    write, or wrote before it kept them)."""
-    from .image import _open
-
-    inp = _open(path)
-    try:
-        spec = inp.spec()
-        return {a.name[len(PREFIX):]: a.value for a in spec.extra_attribs if a.name.startswith(PREFIX)}
-    finally:
-        inp.close()

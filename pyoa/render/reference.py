@@ -87,9 +87,9 @@ def _check_variance_of(vp: Path, path, reference: np.ndarray) -> None:
     another image's (the reference's header names another kind, e.g. a
     render written over it, or other settings), else used with a note on
     stderr saying it is unchecked."""
-    from .provenance import read
+    from .image import read_attributes
 
-    var_meta = read(vp)
+    var_meta = read_attributes(vp)
     again = f"remove {vp} (its noise is then unknown) or make the reference again with pyoa reference"
     digest = var_meta.get(VARIANCE_OF)
     if digest is not None:
@@ -97,7 +97,7 @@ def _check_variance_of(vp: Path, path, reference: np.ndarray) -> None:
             raise ValueError(f"{vp} is the variance of another image than {str(path)!r} (its pixels changed since "
                              f"the variance was written, e.g. an image written over it): {again}")
         return
-    ref_meta = read(path)
+    ref_meta = read_attributes(path)
     kind = ref_meta.get("kind")
     differ = [k for k in _SHARED if k in ref_meta and k in var_meta and ref_meta[k] != var_meta[k]]
     if (kind is not None and kind != "reference") or differ:

@@ -583,13 +583,13 @@ def _mesh(ctx: _Ctx, where: str, file, base: Path, memory: _MeshMemory) -> np.nd
     path = (base / rel).resolve()
     if not path.exists():
         raise FileNotFoundError(f"{ctx.filename}: {where}: mesh file not found: {path}")
-    from .scene_source import _companions
+    from .mesh_files import companions
 
     try:  # a FIFO would block trimesh for ever, a device be read for ever: the mesh and the files it names
         check_state_file(path, "a mesh file", "give a mesh file")
         size = path.stat().st_size
         memory.check(ctx, where, size * MESH_FILE_FACTOR, f"parsing mesh {rel!r} ({size} bytes)")
-        for companion in _companions(path):
+        for companion in companions(path):
             check_state_file(companion, f"a file that mesh {rel!r} names", "give a regular file")
     except NotRegularFile as exc:
         raise ctx.error(where, str(exc)) from None

@@ -25,9 +25,9 @@ import time
 import numpy as np
 import pytest
 
-from pyoa.cli import main
+from pyoa.commands import main
 from pyoa.render.image import read_image, write_exr
-from pyoa.render.provenance import read
+from pyoa.render.image import read_attributes as read
 from pyoa.render.reference import reference_noise
 from pyoa.render.scene import SceneError, bundled, load
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import pyoa
-from pyoa.cli import main
+from pyoa.commands import main
 from pyoa.hostcpu import host_cpu
-from pyoa.render import provenance
+from pyoa.render import image, provenance
 from pyoa.render.image import read_image, write_exr
 from pyoa.render.integrator import RENDERER_VERSION
 from pyoa.render.scene import load
@@ -39,7 +39,7 @@ def test_render_writes_what_made_it(tmp_path, capsys):
     argv = ["render", "dof7d", "--size", "12", "8", "--spp", "9", "--seed", "7", "--sampler", "bose",
             "--filter", "gaussian", "--max-depth", "2", "--out", str(out), "-q"]
     assert main(argv) == 0
-    meta = provenance.read(out)
+    meta = image.read_attributes(out)
     scene = load("dof7d")
     want = {"kind": "render", "scene": "dof7d", "scene_file": str(scene.path), "scene_sha256": scene_digest(scene),
             "width": 12, "height": 8, "sampler": "bose", "spp": 9, "seed": 7, "max_depth": 2, "filter": "gaussian",
@@ -56,7 +56,7 @@ def test_reference_and_its_variance_say_so(tmp_path):
     assert main(["reference", "dof7d", "--size", "8", "8", "--spp", "32", "--pass-spp", "16", "--seed", "3",
                  "--out", str(out), "-q"]) == 0
     for path, kind in ((out, "reference"), (tmp_path / "ref.variance.exr", "reference variance")):
-        meta = provenance.read(path)
+        meta = image.read_attributes(path)
         assert (meta["kind"], meta["sampler"], meta["spp"], meta["passes"], meta["pass_spp"], meta["seed"]) == \
             (kind, "sobol", 32, 2, 16, 3)
         assert meta["command"].startswith("pyoa reference dof7d ")
@@ -67,11 +67,11 @@ def test_progressive_render_counts_its_samples(tmp_path):
     out = tmp_path / "p.exr"
     argv = ["render", "dof7d", "--size", "8", "8", "--sampler", "faure", "--progressive", "--out", str(out), "-q"]
     assert main([*argv, "--spp", "4"]) == 0
-    meta = provenance.read(out)
+    meta = image.read_attributes(out)
     assert (meta["kind"], meta["sampler"], meta["samples"], meta["spp"]) == ("progressive render", "faure", 4, 4)
     assert "base" in meta
     assert main([*argv, "--spp", "8", "--resume"]) == 0
-    assert (provenance.read(out)["samples"], provenance.read(out)["spp"]) == (8, 8)
+    assert (image.read_attributes(out)["samples"], image.read_attributes(out)["spp"]) == (8, 8)
 
 
 def test_info_prints_them_and_json(tmp_path, capsys):
@@ -90,7 +90,7 @@ def test_info_prints_them_and_json(tmp_path, capsys):
     assert main(["info", "--json", str(out)]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data[str(out)]["spp"] == 4 and data[str(out)]["width_px"] == 8
-    assert data[str(out)] == dict(provenance.read(out), width_px=8, height_px=8, channels=3)
+    assert data[str(out)] == dict(image.read_attributes(out), width_px=8, height_px=8, channels=3)
 
 
 def test_info_refuses_a_missing_file_before_printing(tmp_path, capsys):
@@ -110,4 +110,4 @@ def test_metadata_values_are_checked_before_writing(tmp_path):
             write_exr(out, np.ones((2, 2, 3), np.float32), {"x": bad})
         assert not out.exists()
     write_exr(out, np.ones((2, 2, 3), np.float32), {"x": "y", "n": 3})
-    assert provenance.read(out) == {"x": "y", "n": 3}
+    assert image.read_attributes(out) == {"x": "y", "n": 3}
