@@ -651,14 +651,14 @@ def load_reference(scene: str, size: int, quick: bool) -> tuple[np.ndarray, str,
             how = (f"`{rel(ref)}` ({w} x {h}, 4096 spp of sobol in 16 passes of 256, by make_results.py) "
                    f"averaged over {k} x {k} pixels")
             return img.reshape(size, k, size, k, 3).mean(axis=(1, 3)), how, 0.0, 16 * k * k
-    from pyoa import cli
+    from pyoa import commands
 
     spp = 2048 if quick else 32768
     out = OUT / f"{scene}-reference-{size}.exr"
     made = 0.0
     if not out.exists():
         t = time.perf_counter()
-        cli.main(["reference", scene, "--size", str(size), str(size), "--spp", str(spp), "--pass-spp", "256",
+        commands.main(["reference", scene, "--size", str(size), str(size), "--spp", str(spp), "--pass-spp", "256",
                   "--out", str(out), "-q"])
         made = time.perf_counter() - t
         print(f"   reference {scene} {size}x{size} {spp} spp: {made:.0f} s", flush=True)

@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import REPO, machine, replace_section  # noqa: E402
 
 import pyoa  # noqa: E402
-from pyoa import cli  # noqa: E402
+from pyoa import commands  # noqa: E402
 from pyoa.study import PADDED, cells, read_rows  # noqa: E402
 
 RESULTS_MD = REPO / "docs" / "results.md"
@@ -158,7 +158,7 @@ def run(*, quick: bool = False, workers: int = 2, seeds: int = 8, report_only: b
     if workers > 0:
         argv += ["--workers", str(workers)]
     if not report_only:
-        rc = cli.main(argv)
+        rc = commands.main(argv)
         if rc:
             raise SystemExit(rc)
     settings = json.loads((out / "study.json").read_text())

@@ -1,7 +1,7 @@
-"""``python -m pyoa`` runs the command line (see :mod:`pyoa.cli`)."""
+"""``python -m pyoa`` runs the command line (see :mod:`pyoa.commands`)."""
 
 import sys
 
-from .cli import main
+from .commands import main
 
 sys.exit(main())

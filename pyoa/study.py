@@ -881,9 +881,9 @@ def _made_with(saved: dict) -> str:
 def header_passes(path) -> int | None:
     """The passes a reference's header records (``pyoa:passes``, :mod:`pyoa.render.provenance`), or
     None for an image that records none (one pyoa did not make, or a count that is not an int >= 1)."""
-    from .render.provenance import read
+    from .render.image import read_attributes
 
-    passes = read(path).get("passes")
+    passes = read_attributes(path).get("passes")
     return passes if _is_int(passes, 1) else None
 
 
@@ -921,8 +921,8 @@ def _read_own(path: Path, saved: dict, dims) -> np.ndarray | None:
     return pixels if is_reference(saved.get("reference"), path, pixels) else None
 
 
-def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[dict], dims, rendering,
-                    pass_spp: int | None) -> dict:
+def plan_references(given: list[str] | None, reference_spp: int | None, out: Path, loaded: dict, settings: dict,
+                    rows: list[dict], dims, rendering, pass_spp: int | None) -> dict:
     """Every scene's :class:`ReferencePlan`, checked before any work
     (``rendering``: the study's :class:`~pyoa.render.settings.RenderSettings`).
 
@@ -931,19 +931,20 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
     (refused otherwise, before anything is written). A reference in DIR
     whose pixels study.json names, made with this run's settings, is used as
     it is; any other is rendered (resumed from its state) over it, which
-    loses nothing: rows measured against the old one were refused above."""
-    from .render.commands import _check_job_memory
+    loses nothing: rows measured against the old one were refused above.
+    ``given``: the reference images, one per scene in order (None: render
+    them with ``reference_spp`` samples in passes of ``pass_spp``)."""
     from .render.image import EXR, check_output, read_reference
     from .render.reference import reference_key, variance_path
-    from .render.render import plan
+    from .render.render import check_job_memory, plan
     from .render.state import check_state_file, state_path
 
     measured = {r["scene"] for r in rows}
     plans = {}
     for i, (name, scene) in enumerate(loaded.items()):
         saved = settings["scenes"][name]
-        if args.reference:
-            path = Path(args.reference[i])
+        if given:
+            path = Path(given[i])
             # OpenImageIO would wait on a FIFO for ever, and read /dev/zero until memory runs out
             check_state_file(path, "--reference", "give the reference image itself")
             pixels = read_reference(path, "--reference", *dims)
@@ -955,12 +956,12 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
             plans[name] = ReferencePlan(path, pixels)
             continue
         path = out / f"reference-{name}.exr"
-        passes = args.reference_spp // pass_spp
-        made_with = dict(reference_spp=args.reference_spp, reference_passes=passes)
+        passes = reference_spp // pass_spp
+        made_with = dict(reference_spp=reference_spp, reference_passes=passes)
         same = all(saved.get(k) == v for k, v in made_with.items())
         if name in measured and not same:
             raise ValueError(f"{out} holds {name} renders measured against {_made_with(saved)}, not one of "
-                             f"{_in_passes(args.reference_spp, passes)}; give the reference they used, or another "
+                             f"{_in_passes(reference_spp, passes)}; give the reference they used, or another "
                              "--out")
         if name in measured and _by_file(saved):
             # rows measured against a file known only by its bytes: that file, or nothing (rendered again, it
@@ -983,75 +984,146 @@ def plan_references(args, out: Path, loaded: dict, settings: dict, rows: list[di
         check_output(path, "the study's reference", EXR)
         check_output(variance_path(path), "the study's reference variance", EXR)
         p = plan(scene, rendering, sampler="sobol", spp=pass_spp, seed=0)
-        _check_job_memory(p, f"a {name} reference pass of {pass_spp} spp")
+        check_job_memory(p, f"a {name} reference pass of {pass_spp} spp")
         key = reference_key(scene, p, pass_spp=pass_spp, passes=passes, seed=0)
         plans[name] = ReferencePlan(path, None, key, made_with)
     return plans
 
 
-def run(args) -> int:
-    """``pyoa study`` (see the module docstring and ``pyoa study --help``)."""
+@dataclass(frozen=True)
+class StudySettings:
+    """What a study computes and where it keeps it, as one immutable value (the study's counterpart of
+    :class:`~pyoa.render.settings.RenderSettings`; ``pyoa study``'s options build it).
+
+    Parameters
+    ----------
+    scenes : tuple of str
+        Bundled scene names or scene files; a name given twice counts once.
+    out : str or path
+        The study's directory (study.csv, study.json, study.md, the figures, rendered references). A
+        study whose directory holds rows continues it.
+    samplers : str or sequence of str
+        Sampler names (aliases allowed; ``"all"``: every sampler), as a sequence or comma-separated.
+    spp : str or sequence of int
+        Sample counts; a sampler without one uses its nearest valid count.
+    seeds, seed : int
+        Renders per (scene, sampler, count), with seeds ``seed, seed + 1, ...``.
+    reference : sequence of str, optional
+        The reference images, ``SCENE=FILE`` each (``FILE`` alone for one scene). Give these or
+        ``reference_spp``.
+    reference_spp, pass_spp : int, optional
+        Render the references with ``reference_spp`` samples (sobol) in passes of ``pass_spp``.
+    size : (int, int), optional
+        Image size (default: the references', else the scenes').
+    crop : (int, int, int, int), optional
+        Crop window ``(x, y, w, h)`` of the cropped relMSE (default the quarter-size window at
+        ``(W/4, H/4)``).
+    max_depth, filter, backend, device, shading
+        As :class:`~pyoa.render.settings.RenderSettings`.
+    workers, scheduler
+        The engine (:func:`pyoa.cluster.engine`): worker processes of a local cluster, or a
+        scheduler's address; neither: in-process.
+    quiet : bool
+        Print nothing (the report is in ``out/study.md``).
+    command : str, optional
+        The command line recorded in rendered references' headers (:mod:`pyoa.render.provenance`).
+    """
+
+    scenes: tuple[str, ...]
+    out: str | os.PathLike
+    samplers: str | tuple[str, ...] = ",".join(catalogue.DEFAULT_SAMPLERS)
+    spp: str | tuple[int, ...] = "16,64,256,1024"
+    seeds: int = 8
+    seed: int = 0
+    reference: tuple[str, ...] | None = None
+    reference_spp: int | None = None
+    pass_spp: int = 256
+    size: tuple[int, int] | None = None
+    crop: tuple[int, int, int, int] | None = None
+    max_depth: int | None = None
+    filter: str = "box"
+    backend: str | None = None
+    device: str | None = None
+    shading: str | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+    quiet: bool = False
+    command: str | None = None
+
+    def __post_init__(self):
+        # sequences are kept as the comma-separated text the command line gives: the report's labels show the
+        # names as typed, and the parsers (parse_spp, sampler_labels) check them in one place
+        if not isinstance(self.samplers, str):
+            object.__setattr__(self, "samplers", ",".join(map(str, self.samplers)))
+        if not isinstance(self.spp, str):
+            object.__setattr__(self, "spp", ",".join(map(str, self.spp)))
+        object.__setattr__(self, "scenes", tuple(self.scenes))
+
+
+def run_study(settings: StudySettings) -> int:
+    """Run the study ``settings`` describes (``pyoa study``; see the module docstring), or continue it from
+    what its directory holds. Returns 0; a refusal is a ValueError (or OSError) raised before any work."""
     from .cluster import check_engine, engine, progress_over
-    from .render.commands import _check_job_memory, _default_crop, check_seeds
-    from .render.image import check_crop, read_reference
+    from .render.image import check_crop, default_crop, read_reference
     from .render.integrator import RENDERER_VERSION
-    from .render.provenance import command_line, describe
+    from .render.provenance import describe
     from .render.reference import reference_noise, render_reference, variance_path
-    from .render.render import plan, resolve_shading
+    from .render.render import check_job_memory, plan, resolve_shading
     from .render.scene import load
     from .render.scene_source import source_of
-    from .render.settings import RenderSettings
+    from .render.settings import RenderSettings, check_seeds
     from .render.state import scene_digest
 
     t_start = time.perf_counter()
-    scenes_arg = list(dict.fromkeys(args.scenes))
-    names = sampler_names(args.samplers)
-    spp_list = parse_spp(args.spp)
-    seed_list = check_seeds(args.seed, args.seeds)
+    scenes_arg = list(dict.fromkeys(settings.scenes))
+    names = sampler_names(settings.samplers)
+    spp_list = parse_spp(settings.spp)
+    seed_list = check_seeds(settings.seed, settings.seeds)
     seeds, seed0 = len(seed_list), seed_list[0]
-    if args.max_depth is not None:
+    if settings.max_depth is not None:
         from .render.layout import MAX_DEPTH
 
-        check_int("--max-depth", args.max_depth, 1, MAX_DEPTH)
-    if args.size is not None:
-        for n, v in zip(("W", "H"), args.size):
+        check_int("--max-depth", settings.max_depth, 1, MAX_DEPTH)
+    if settings.size is not None:
+        for n, v in zip(("W", "H"), settings.size):
             check_int(f"--size {n}", v, 1)
-    if args.reference and args.reference_spp is not None:
+    if settings.reference and settings.reference_spp is not None:
         raise ValueError("give --reference (existing images) or --reference-spp (render them), not both")
-    if not args.reference and args.reference_spp is None:
+    if not settings.reference and settings.reference_spp is None:
         raise ValueError("a study needs references: --reference SCENE=REF.exr per scene (REF.exr alone for one "
                          "scene), or --reference-spp N to render them (pyoa reference, e.g. 16384)")
-    args.reference = reference_files(args.reference, scenes_arg)  # one per scene, in the scenes' order
-    if args.reference:
+    given = reference_files(list(settings.reference) if settings.reference else None, scenes_arg)  # one per scene, in order
+    size = list(settings.size) if settings.size is not None else None
+    if given:
         # the references fix the size, as in pyoa compare; one of another size than --size (or than the
         # first reference) is refused before the study's directory is made
         from .render.image import check_reference, image_info
         from .render.state import check_state_file
 
-        for path in args.reference:
+        for path in given:
             # OpenImageIO would wait on a FIFO for ever, and read /dev/zero until memory runs out
             check_state_file(path, "--reference", "give the reference image itself")
-        if args.size is None:
-            args.size = list(image_info(args.reference[0], "--reference")[:2])
-        for path in args.reference:
-            check_reference(path, "--reference", *args.size)
+        if size is None:
+            size = list(image_info(given[0], "--reference")[:2])
+        for path in given:
+            check_reference(path, "--reference", *size)
     pass_spp = None
-    if args.reference_spp is not None:
-        check_int("--reference-spp", args.reference_spp, 1)
-        pass_spp = check_int("--pass-spp", min(args.pass_spp, args.reference_spp), 1, MAX_SPP)
-        if args.reference_spp % pass_spp:
-            raise ValueError(f"--reference-spp ({args.reference_spp}) must be a multiple of --pass-spp ({pass_spp})")
-    check_engine(args.workers, args.scheduler)
-    out = check_out_dir(args.out)
+    if settings.reference_spp is not None:
+        check_int("--reference-spp", settings.reference_spp, 1)
+        pass_spp = check_int("--pass-spp", min(settings.pass_spp, settings.reference_spp), 1, MAX_SPP)
+        if settings.reference_spp % pass_spp:
+            raise ValueError(f"--reference-spp ({settings.reference_spp}) must be a multiple of --pass-spp ({pass_spp})")
+    check_engine(settings.workers, settings.scheduler)
+    out = check_out_dir(settings.out)
     with lock_study(out):
         # the saved study first: a damaged study.json or study.csv is refused before the scenes are loaded
         saved = load_settings(out / "study.json")
         rows = read_rows(out / "study.csv")
-        shading = resolve_shading(args.shading)
-        size = dict(width=args.size[0], height=args.size[1]) if args.size else dict(width=None, height=None)
+        shading = resolve_shading(settings.shading)
+        film = dict(width=size[0], height=size[1]) if size else dict(width=None, height=None)
         # every render of the study, its references' passes included, with its sampler, count and seed
-        rendering = RenderSettings(**size, max_depth=args.max_depth, filter=args.filter, backend=args.backend,
-                                   device=args.device, shading=shading)
+        rendering = RenderSettings(**film, max_depth=settings.max_depth, filter=settings.filter, backend=settings.backend,
+                                   device=settings.device, shading=shading)
         # every check a long job could fail at its end, on the client, before any task
         loaded, jobs, dims = {}, [], None
         for sname in scenes_arg:
@@ -1065,24 +1137,24 @@ def run(args) -> int:
                     if n is None:
                         raise ValueError(f"{name} has no valid sample count near {asked}")
                     p = plan(scene, rendering, sampler=name, spp=n, seed=seed0)
-                    _check_job_memory(p, f"a {scene.name} render with {name} at {n} spp")
+                    check_job_memory(p, f"a {scene.name} render with {name} at {n} spp")
                     if dims is None:
                         dims, first = (p.width, p.height), scene.name
                     elif (p.width, p.height) != dims:
                         raise ValueError(f"{first} renders {dims[0]} x {dims[1]} and {scene.name} "
                                          f"{p.width} x {p.height}; a study has one size: give --size W H")
                     jobs += [Job(scene.name, name, asked, n, seed0 + k) for k in range(seeds)]
-        crop = tuple(args.crop) if args.crop else _default_crop((dims[1], dims[0]))
+        crop = tuple(settings.crop) if settings.crop else default_crop((dims[1], dims[0]))
         check_crop(crop, *dims)
-        settings = dict(version=STUDY_VERSION, renderer=RENDERER_VERSION, size=list(dims), crop=list(crop),
-                        max_depth=args.max_depth, filter=args.filter, shading=shading,
+        record = dict(version=STUDY_VERSION, renderer=RENDERER_VERSION, size=list(dims), crop=list(crop),
+                        max_depth=settings.max_depth, filter=settings.filter, shading=shading,
                         scenes={n: dict(digest=scene_digest(s)) for n, s in loaded.items()})
-        settings = check_settings(out, saved, settings)
+        record = check_settings(out, saved, record)
         for r in rows:
-            if r["scene"] in loaded and settings["scenes"][r["scene"]].get("reference") is None:
+            if r["scene"] in loaded and record["scenes"][r["scene"]].get("reference") is None:
                 raise ValueError(f"{out / 'study.csv'} holds {r['scene']} rows but study.json no reference for "
                                  "them; give another --out")
-        refs = plan_references(args, out, loaded, settings, rows, dims, rendering, pass_spp)
+        refs = plan_references(given, settings.reference_spp, out, loaded, record, rows, dims, rendering, pass_spp)
         # no file the study writes (study.csv is appended to) may be one it reads, by any link or spelling
         check_not_inputs([("--out", out / f) for f in ("study.csv", "study.json", "study.md", "study.png",
                                                        *(f"study-{n}.png" for n in loaded))],
@@ -1092,23 +1164,23 @@ def run(args) -> int:
         noise = {n: reference_noise(r.path, r.pixels, crop) for n, r in refs.items() if r.pixels is not None}
         # every check made: now the rows the run appends to, as the catalogue spells them, once each
         rows = read_rows(out / "study.csv", repair=True)
-        with engine(args.workers, args.scheduler) as eng:
+        with engine(settings.workers, settings.scheduler) as eng:
             where = eng.description
             # references first (resumable passes on the same engine)
             images = {}
             for name, scene in loaded.items():
-                ref, rec = refs[name], settings["scenes"][name]
+                ref, rec = refs[name], record["scenes"][name]
                 if ref.pixels is None:
                     passes = ref.key["passes"]
-                    if not args.quiet:
-                        print(f"reference of {name}: {args.reference_spp} spp in {passes} passes on {where}")
+                    if not settings.quiet:
+                        print(f"reference of {name}: {settings.reference_spp} spp in {passes} passes on {where}")
                     one_pass = rendering.replace(sampler="sobol", spp=pass_spp, seed=0)
                     meta = describe(scene, plan(scene, one_pass), kind="reference",
-                                    command=command_line(args.argv) if hasattr(args, "argv") else None,
+                                    command=settings.command,
                                     passes=passes, pass_spp=pass_spp)
-                    meta["spp"] = args.reference_spp
+                    meta["spp"] = settings.reference_spp
                     render_reference(eng, scene, out=ref.path, key=ref.key, settings=one_pass, seed=0,
-                                     quiet=args.quiet, command="pyoa study", metadata=meta)
+                                     quiet=settings.quiet, command="pyoa study", metadata=meta)
                     ref.pixels = read_reference(ref.path, "the study's reference", *dims)
                     if any(r["scene"] == name for r in rows) and not is_reference(rec.get("reference"), ref.path,
                                                                                    ref.pixels):
@@ -1128,10 +1200,10 @@ def run(args) -> int:
                 shown = ref.path.name if ref.path.resolve().parent == out.resolve() else str(ref.path)  # DIR's own
                 rec.update(reference=identity, reference_name=shown,
                            noise=list(noise[name]) if noise[name] else None)
-            write_settings(out / "study.json", settings)
+            write_settings(out / "study.json", record)
             done = {ident(r) for r in rows}
             todo = [j for j in jobs if j.ident not in done]
-            if not args.quiet:
+            if not settings.quiet:
                 print(f"study: {len(jobs)} renders, {len(jobs) - len(todo)} already in {out / 'study.csv'}, "
                       f"{len(todo)} to render on {where}")
             shared = {n: (eng.share(s if eng.client is None else source_of(s)), eng.share(images[n]))
@@ -1141,81 +1213,34 @@ def run(args) -> int:
             writer = RowWriter(out / "study.csv")
             try:
                 with closing(eng.run(study_task, args_list, key="pyoa-study")) as results:
-                    for _, row in progress_over(results, len(todo), "study", args.quiet, unit="render"):
+                    for _, row in progress_over(results, len(todo), "study", settings.quiet, unit="render"):
                         writer.add(row)
                         rows.append(row)
             finally:
                 writer.close()
         seconds = time.perf_counter() - t_start
         # what each run (the first and every resumption) rendered, where, and how long it took
-        settings["runs"] = [*settings.get("runs", []), dict(seconds=round(seconds, 1), where=where,
+        record["runs"] = [*record.get("runs", []), dict(seconds=round(seconds, 1), where=where,
                                                             rendered=len(todo),
                                                             date=time.strftime("%Y-%m-%dT%H:%M:%S"))]
-        write_settings(out / "study.json", settings)
+        write_settings(out / "study.json", record)
         wanted = {j.ident for j in jobs}
         mine = [r for r in rows if ident(r) in wanted]
         # the report follows the command's order of scenes and samplers, not the order rows were rendered in
         # (a resumed study appends the rows it renders after the ones it found)
         place = {(s, n): k for k, (s, n) in enumerate((s, n) for s in loaded for n in names)}
         mine.sort(key=lambda r: (place.get((r["scene"], r["sampler"]), len(place)), r["spp_asked"], r["seed"]))
-        md = report(settings, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in settings["runs"]),
-                    where=where, labels=sampler_labels(args.samplers))
+        md = report(record, mine, noise, samplers=names, seconds=sum(r["seconds"] for r in record["runs"]),
+                    where=where, labels=sampler_labels(settings.samplers))
         with atomic_path(out / "study.md") as tmp:
             tmp.write_text(md)
         table = cells(mine, noise)
         plot(out / "study.png", table, list(loaded), names)
         for name in loaded:
             plot(out / f"study-{name}.png", table, [name], names)
-    if not args.quiet:
+    if not settings.quiet:
         print(md)
         print(f"-> {out / 'study.md'}, {out / 'study.csv'}, {out / 'study.png'} ({seconds:.0f} s)")
     return 0
 
 
-def interrupted(args) -> str:
-    """What an interrupted study leaves (``pyoa.cli`` prints it): the rows
-    and reference passes already in DIR, which a rerun continues from."""
-    out = Path(args.out)
-    if (out / "study.csv").is_file() or any(out.glob("*.state.npz")):
-        return f"the finished renders are kept in {out} (run the same command again to continue)"
-    return "no render finished"
-
-
-def add_parser(sub) -> None:
-    """``pyoa study`` on the command line."""
-    from .cli import add_sampling_options
-    from .cluster import add_arguments
-    from .render.render import SHADINGS
-
-    p = sub.add_parser("study", help="error against spp over seeds, with confidence intervals (renders, CSV, "
-                                     "report, figures)")
-    p.add_argument("scenes", nargs="+", metavar="SCENE", help="bundled scene names or .json files")
-    p.add_argument("--samplers", default=",".join(catalogue.DEFAULT_SAMPLERS),
-                   help=f"comma-separated sampler names, or all (default: bose and every comparison sampler, "
-                        f"{','.join(catalogue.DEFAULT_SAMPLERS)})")
-    p.add_argument("--spp", default="16,64,256,1024",
-                   help="comma-separated sample counts; a sampler without one uses its nearest valid count "
-                        "(default 16,64,256,1024)")
-    p.add_argument("--seeds", type=int, default=8, help="renders per (scene, sampler, spp), seeds --seed, "
-                                                         "--seed+1, ... (default 8)")
-    p.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
-    p.add_argument("--reference", action="append", default=None, metavar="SCENE=REF.exr",
-                   help="the reference image of a scene; repeat it for each scene (REF.exr alone when the study "
-                        "has one scene)")
-    p.add_argument("--reference-spp", type=int, default=None, metavar="N",
-                   help="render the references (pyoa reference, sobol passes) with N spp into DIR")
-    p.add_argument("--pass-spp", type=int, default=256, help="samples per reference pass (default 256)")
-    p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None,
-                   help="image size (default: the references' when --reference is given, and a --size that "
-                        "differs from theirs is refused; else the scenes')")
-    p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), default=None,
-                   help="crop window (default: the quarter-size window at (W/4, H/4))")
-    p.add_argument("--max-depth", type=int, default=None, help="longest path in segments (default: the scene's)")
-    p.add_argument("--filter", choices=("box", "gaussian"), default="box", help="pixel filter (default box)")
-    add_sampling_options(p)
-    p.add_argument("--shading", choices=SHADINGS, default=None, help="numba (default) or numpy")
-    p.add_argument("--out", required=True, metavar="DIR", help="directory of study.csv, study.md, the figures "
-                                                               "(and the references)")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing (the report is in DIR/study.md)")
-    add_arguments(p)
-    p.set_defaults(func=run, interrupted=interrupted)

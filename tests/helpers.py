@@ -633,10 +633,10 @@ def randfloat_preimage(h: int, p: int) -> int:
 
 def run_cli(args, capsys):
     """Run ``pyoa ARGS`` in-process: (exit status, stdout, stderr)."""
-    from pyoa import cli
+    from pyoa import commands
 
     try:
-        code = cli.main([str(a) for a in args])
+        code = commands.main([str(a) for a in args])
     except SystemExit as exc:
         code = exc.code
     out = capsys.readouterr()

@@ -1,4 +1,4 @@
-"""The command line (pyoa.cli): files equal to the API bit for bit, errors exit 2,
+"""The command line (pyoa.commands): files equal to the API bit for bit, errors exit 2,
 writes are atomic."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import pyoa
-from pyoa import cli
+from pyoa import commands
 from tests.helpers import assert_same_bits, run_cli
 
 
@@ -342,7 +342,7 @@ def test_spectrum_takes_its_pair_as_pair_and_the_old_dims_with_a_note(tmp_path, 
 
 
 def test_render_and_the_points_commands_share_the_default_spp():
-    from pyoa import cli
-    from pyoa.render import commands
+    from pyoa import commands
+    from pyoa.commands import render as render_commands
 
-    assert cli.DEFAULT_SPP == commands.DEFAULT_SPP == 121
+    assert commands.options.DEFAULT_SPP == render_commands.DEFAULT_SPP == 121

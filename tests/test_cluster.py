@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from pyoa import cluster
-from pyoa.cli import main
+from pyoa.commands import main
 from pyoa.render import reference as reference_mod
 from pyoa.render.image import read_image
 from pyoa.render.render import render
@@ -166,7 +166,7 @@ def test_an_interrupted_reference_resumes_on_the_cluster(tmp_path, scheduler, mo
             raise KeyboardInterrupt
 
     monkeypatch.setattr(reference_mod.Passes, "add", add)
-    with pytest.raises(SystemExit, match="^130$"):  # pyoa.cli: Ctrl-C is exit status 130
+    with pytest.raises(SystemExit, match="^130$"):  # pyoa.commands: Ctrl-C is exit status 130
         main(["reference", *REF, "--out", str(out), "--scheduler", scheduler])
     monkeypatch.setattr(reference_mod.Passes, "add", real_add)
     state = reference_mod.state_path(out)
@@ -259,7 +259,7 @@ def test_an_interrupted_study_resumes_and_renders_only_what_is_missing(inprocess
             raise KeyboardInterrupt
 
     monkeypatch.setattr(study.RowWriter, "add", add)
-    with pytest.raises(SystemExit, match="^130$"):  # pyoa.cli: Ctrl-C is exit status 130
+    with pytest.raises(SystemExit, match="^130$"):  # pyoa.commands: Ctrl-C is exit status 130
         main(["study", *STUDY, "--out", str(out)])
     monkeypatch.setattr(study.RowWriter, "add", real)
     rendered = []

@@ -154,7 +154,7 @@ def test_study_headline_names_only_the_padded_samplers_that_ran(refs, tmp_path):
 
 
 def _parser():
-    from pyoa.cli import build_parser
+    from pyoa.commands.main import build_parser
 
     return build_parser()
 

@@ -97,15 +97,15 @@ def test_study_figure_without_such_bands_has_no_note():
 def test_compare_figure_puts_the_colour_bar_beside_the_last_error_map(shape, samplers):
     from matplotlib.colors import LogNorm
 
-    from pyoa.render import commands
+    from pyoa.commands import render as render_commands
 
     h, w = shape
     rng = np.random.default_rng(1)
     ref = (rng.random((h, w, 3)) + 0.2).astype(np.float32)
     crop = (2, 2, 8, 8)
-    panels = [(f"s{k}", 16, commands.figure_panels((ref * rng.uniform(0.8, 1.2, ref.shape)).astype(np.float32),
+    panels = [(f"s{k}", 16, render_commands.figure_panels((ref * rng.uniform(0.8, 1.2, ref.shape)).astype(np.float32),
                                                    ref, crop)) for k in range(samplers)]
-    fig = commands.comparison_figure(panels, ref, crop)
+    fig = render_commands.comparison_figure(panels, ref, crop)
     fig.canvas.draw()
     r = fig.canvas.get_renderer()
     maps = [im for ax in fig.axes for im in ax.get_images() if isinstance(im.norm, LogNorm)]
@@ -124,11 +124,11 @@ def test_compare_figure_puts_the_colour_bar_beside_the_last_error_map(shape, sam
 
 
 def test_compare_figure_is_written_as_png(tmp_path):
-    from pyoa.render import commands
+    from pyoa.commands import render as render_commands
 
     ref = np.full((8, 8, 3), 0.5, np.float32)
     img = ref + np.float32(0.01)
-    commands.compare_figure(tmp_path / "c.png", [("bose", 4, commands.figure_panels(img, ref, (0, 0, 4, 4)))],
+    render_commands.compare_figure(tmp_path / "c.png", [("bose", 4, render_commands.figure_panels(img, ref, (0, 0, 4, 4)))],
                             ref, (0, 0, 4, 4))
     assert (tmp_path / "c.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 

@@ -34,8 +34,8 @@ OLD = b"previous output"
 #: scheduler listens (10 s by default: too long for the suite).
 TIMEOUT = 2
 
-#: Runs ``pyoa.cli.main`` with ``cluster.CONNECT_TIMEOUT = TIMEOUT``, as ``python -m pyoa`` runs it.
-MAIN = ("import sys, pyoa.cluster; pyoa.cluster.CONNECT_TIMEOUT = %d; from pyoa.cli import main; "
+#: Runs ``pyoa.commands.main`` with ``cluster.CONNECT_TIMEOUT = TIMEOUT``, as ``python -m pyoa`` runs it.
+MAIN = ("import sys, pyoa.cluster; pyoa.cluster.CONNECT_TIMEOUT = %d; from pyoa.commands import main; "
         "sys.exit(main(sys.argv[1:]))" % TIMEOUT)
 
 #: case -> (--scheduler value or None, $PYOA_SCHEDULER or None, words of the message)

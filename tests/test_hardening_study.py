@@ -27,7 +27,7 @@ import OpenImageIO as oiio
 import pytest
 
 from pyoa import study
-from pyoa.cli import main
+from pyoa.commands import main
 from pyoa.render.image import read_image
 from pyoa.render.reference import reference_noise
 from pyoa.render.scene import bundled

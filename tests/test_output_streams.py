@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyoa import cli
+from pyoa import commands
 
 #: The environment of the subprocesses: unbuffered standard output (as PYTHONUNBUFFERED=1 or a
 #: terminal makes it), so that a print meets the closed pipe at once, not at the flush at exit.
@@ -44,7 +44,7 @@ def test_info_escapes_control_characters_of_header_strings_and_names(tmp_path, c
     path = foreign_exr(tmp_path / "a\nkind  render.exr", {
         "pyoa:scene": "cornell\nkind  reference", "pyoa:command": "pyoa render\x1b[2J\rforged\u202e",
         "pyoa:kind": "render"})
-    assert cli.main(["info", str(path)]) == 0
+    assert commands.main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\r" not in out and "\u202e" not in out
     lines = out.splitlines()
@@ -63,7 +63,7 @@ def test_info_json_is_strict_json_for_non_finite_header_floats(tmp_path, capsys)
     def refuse(constant):
         raise ValueError(f"not JSON: {constant}")
 
-    assert cli.main(["info", "--json", str(path)]) == 0
+    assert commands.main(["info", "--json", str(path)]) == 0
     got = json.loads(capsys.readouterr().out, parse_constant=refuse)[str(path)]
     assert got["spp"] == "nan" and got["seed"] == "inf" and got["base"] == "-inf" and got["samples"] == 2.5
     assert (got["width_px"], got["height_px"], got["channels"]) == (4, 2, 3)

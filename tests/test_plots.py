@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pyoa import cli
+from pyoa import commands
 from pyoa.plots import power_spectrum, projections, radial_mean, spectrum
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -92,11 +92,11 @@ def test_spectrum_bad_arguments(tmp_path, kw, words):
 
 def test_cli_plot_and_spectrum(tmp_path, capsys):
     out = tmp_path / "proj.png"
-    assert cli.main(["plot", "cmjnd", "--spp", "27", "--dims", "3", "--figure-width", "120", "--out", str(out),
+    assert commands.main(["plot", "cmjnd", "--spp", "27", "--dims", "3", "--figure-width", "120", "--out", str(out),
                      "--backend", "numpy"]) == 0
     assert png_shape(out) == (120, 120)
     out = tmp_path / "spec.png"
-    assert cli.main(["spectrum", "jittered2d", "--spp", "49", "--pair", "2,3", "--trials", "8", "--freq", "8",
+    assert commands.main(["spectrum", "jittered2d", "--spp", "49", "--pair", "2,3", "--trials", "8", "--freq", "8",
                      "--figure-width", "160", "--out", str(out), "--backend", "numpy"]) == 0
     assert png_shape(out) == (80, 160)
     assert "low-frequency power" in capsys.readouterr().out
@@ -109,7 +109,7 @@ def test_cli_plot_and_spectrum(tmp_path, capsys):
 ])
 def test_cli_figure_errors(tmp_path, capsys, argv, words):
     with pytest.raises(SystemExit) as ex:
-        cli.main([*argv, "--out", str(tmp_path / "x.png"), "--figure-width", "100"])
+        commands.main([*argv, "--out", str(tmp_path / "x.png"), "--figure-width", "100"])
     assert ex.value.code == 2
     err = capsys.readouterr().err
     assert all(w in err for w in words), err

@@ -14,7 +14,7 @@ import shutil
 import pytest
 
 from pyoa import study
-from pyoa.cli import main
+from pyoa.commands import main
 from pyoa.render.scene import bundled
 
 NAMES = ["a\nb", "cr\rz", 'say "hi"', "x,y", "été ünï 日本", "cr\rlf\r\n", "\u2028sep", "plain"]

@@ -12,14 +12,15 @@ from .. import catalogue
 from ..analysis.statistics import corrected, mean_ci, ratio_ci, relmse_noise
 from ..atomic import atomic_path, check_not_inputs
 from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
-from ..cli import DEFAULT_SPP, add_sampling_options, resolve_spp
 from ..cluster import add_arguments as add_engine_arguments
 from ..cluster import check_engine, engine
 from ..units import format_interval, format_rate, format_ratio
-from .image import (
+from .options import DEFAULT_SPP, add_sampling_options, resolve_spp
+from ..render.image import (
     EXR,
     PNG,
     check_crop,
+    default_crop,
     check_finite,
     check_output,
     check_writable,
@@ -28,29 +29,22 @@ from .image import (
     write_exr,
     write_png,
 )
-from .layout import MAX_DEPTH
-from .progressive import check_progressive, render_progressive, state_path
-from .provenance import command_line, describe, printable
-from .reference import reference_key, reference_noise, render_reference, variance_path
-from .render import SHADINGS, check_memory, plan
-from .scene import load
-from .settings import RenderSettings
-from .state import check_state_file
-from .tiles import render_on
+from ..render.layout import MAX_DEPTH
+from ..render.progressive import check_progressive, render_progressive, state_path
+from ..render.provenance import command_line, describe, printable
+from ..render.reference import reference_key, reference_noise, render_reference, variance_path
+from ..render.render import SHADINGS, check_job_memory, plan
+from ..render.scene import load
+from ..render.settings import RenderSettings, check_seeds
+from ..render.state import check_state_file
+from ..render.tiles import render_on
 
-#: Bytes per pixel that a command allocates besides the render, bounded: the
-#: PNG's float64 sRGB conversion, the reference and the float64 copies of
-#: relMSE (``pyoa render``, ``pyoa compare``), the float64 running sum, its
-#: pass and the mean (``pyoa reference``).
-POST_PIXEL_BYTES = 256
-#: Most seeds per sampler of ``pyoa compare --seeds`` and ``pyoa study --seeds``: a typo guard.
-MAX_SEEDS = 1 << 16
 #: Most passes of ``pyoa reference``: pass seeds hash a uint32 pass index.
 MAX_PASSES = MAX_UINT32 + 1
 
 
 def _command(args) -> str | None:
-    """The command line of this run (``pyoa.cli.main`` keeps it), for the images' headers."""
+    """The command line of this run (``pyoa.commands.main`` keeps it), for the images' headers."""
     argv = getattr(args, "argv", None)
     return None if argv is None else command_line(argv)
 
@@ -72,11 +66,6 @@ def _check_counts(args, spp: bool = True) -> None:
     if args.size is not None:
         for name, v in zip(("W", "H"), args.size):
             check_int(f"--size {name}", v, 1)
-
-
-def _check_job_memory(p, what: str) -> None:
-    """The render's own need plus what the command allocates after it, against the same limit."""
-    check_memory(p.nbytes + p.width * p.height * POST_PIXEL_BYTES, what, p.max_bytes)
 
 
 def _settings(args, sampler: str, spp: int, seed: int | None = None, base: int | None = None) -> RenderSettings:
@@ -118,7 +107,7 @@ def cmd_render(args) -> int:
     check_engine(args.workers, args.scheduler)
     scene = load(args.scene)
     p = _plan(scene, args, args.sampler, args.spp, base=args.base)
-    _check_job_memory(p, f"pyoa render of {p.width} x {p.height} at {p.sampler.spp} spp")
+    check_job_memory(p, f"pyoa render of {p.width} x {p.height} at {p.sampler.spp} spp")
     ref = noise = None
     if args.reference:
         ref = read_reference(args.reference, "--reference", p.width, p.height)
@@ -200,14 +189,6 @@ def _compare_outputs(out: str) -> list[Path]:
     return paths
 
 
-def check_seeds(seed, seeds) -> list[int]:
-    """The seeds of ``--seed S --seeds N``: S, S+1, ..., S+N-1, all uint32 (``pyoa compare`` and
-    ``pyoa study``)."""
-    n = check_int("--seeds", seeds, 1, MAX_SEEDS)
-    first = check_int("--seed", seed, 0, MAX_UINT32 - n + 1, " (the first of --seeds uint32 seeds)")
-    return list(range(first, first + n))
-
-
 def cmd_compare(args) -> int:
     # "all": every sampler of the catalogue, as study reads it
     typed = (list(catalogue.names()) if args.samplers.strip().lower() == "all" else
@@ -224,7 +205,7 @@ def cmd_compare(args) -> int:
     md_path, csv_path, png_path = _compare_outputs(args.out)
     check_not_inputs([("--out", path) for path in (md_path, csv_path, png_path)], _reference_inputs(args.reference))
     if args.size is None:  # the reference fixes the size: it need not be repeated
-        from .image import image_info
+        from ..render.image import image_info
 
         args.size = list(image_info(args.reference, "--reference")[:2])
     scene = load(args.scene)
@@ -232,10 +213,10 @@ def cmd_compare(args) -> int:
     for name in names:  # every sampler's render is checked before the first one starts
         spp = catalogue.nearest_spp(name, args.spp)
         p = _plan(scene, args, name, spp)
-        _check_job_memory(p, f"pyoa compare of {p.width} x {p.height} at {spp} spp ({name})")
+        check_job_memory(p, f"pyoa compare of {p.width} x {p.height} at {spp} spp ({name})")
         jobs.append((name, spp))
     ref = read_reference(args.reference, "--reference", p.width, p.height)
-    crop = args.crop or _default_crop(ref.shape)
+    crop = args.crop or default_crop(ref.shape)
     check_crop(crop, p.width, p.height)
     noise = reference_noise(args.reference, ref[..., :3].astype("float64"), crop)
     check_engine(args.workers, args.scheduler)
@@ -278,11 +259,6 @@ def _compare_one(eng, scene, args, name: str, spp: int, seed: int, ref, crop, cr
         print(f"{label:12s} {spp:6d} spp  seed {seed:<4d} relMSE {row['relmse']:.5g}  crop {row['relmse_crop']:.5g}  "
               f"({res.seconds:.1f} s)")
     return row
-
-
-def _default_crop(shape):
-    h, w = shape[:2]
-    return (w // 4, h // 4, max(1, w // 4), max(1, h // 4))
 
 
 def markdown_table(scene: str, rows: list[dict], crop, *, seeds: list[int], noise, reference, asked: int,
@@ -382,7 +358,7 @@ def comparison_figure(panels, ref, crop):
     from matplotlib.figure import Figure
     from matplotlib.patches import Rectangle
 
-    from .image import to_srgb8
+    from ..render.image import to_srgb8
 
     x, y, w, h = crop
     k = panels[0][2][3] if panels else 1
@@ -469,7 +445,7 @@ def cmd_reference(args) -> int:
     check_not_inputs([("--out", args.out), ("--out (its variance)", variance_path(args.out)),
                       ("--out (its running sum)", state_path(args.out))], [("the scene file", scene.path)])
     p = _plan(scene, args, args.sampler, args.pass_spp)
-    _check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
+    check_job_memory(p, f"pyoa reference of {p.width} x {p.height} at {args.pass_spp} spp per pass")
     key = reference_key(scene, p, pass_spp=args.pass_spp, passes=passes, seed=args.seed)
     settings = p.worker_settings()
     meta = describe(scene, p, kind="reference", command=_command(args), passes=passes, pass_spp=args.pass_spp)
@@ -497,12 +473,12 @@ def cmd_info(args) -> int:
     """``pyoa info FILE ...``: each image's size and what made it (:mod:`pyoa.render.provenance`)."""
     import json
 
-    from .image import image_info
-    from .provenance import json_value, read
+    from ..render.image import image_info, read_attributes
+    from ..render.provenance import json_value
 
     found = {}
     for path in args.files:  # every file is read before anything is printed: one bad name, one error
-        found[path] = (image_info(path), read(path))
+        found[path] = (image_info(path), read_attributes(path))
     if args.json:  # strict JSON (allow_nan=False): a foreign header's NaN is a string, never a bare NaN
         print(json.dumps({str(p): dict({k: json_value(v) for k, v in meta.items()}, width_px=info[0],
                                        height_px=info[1], channels=info[2])
@@ -524,7 +500,7 @@ def cmd_info(args) -> int:
 
 
 def render_interrupted(args) -> str:
-    """What an interrupted ``pyoa render`` leaves (``pyoa.cli`` prints it):
+    """What an interrupted ``pyoa render`` leaves (:func:`pyoa.commands.main.main` prints it):
     a progressive render's last complete doubling, else nothing."""
     state = state_path(args.out)
     if args.progressive and state.is_file():
@@ -533,7 +509,7 @@ def render_interrupted(args) -> str:
 
 
 def reference_interrupted(args) -> str:
-    """What an interrupted ``pyoa reference`` leaves (``pyoa.cli`` prints it): its finished passes."""
+    """What an interrupted ``pyoa reference`` leaves (:func:`pyoa.commands.main.main` prints it): its finished passes."""
     state = state_path(args.out)
     if state.is_file():
         return f"the finished passes are kept in {state} (run the same command again to resume)"

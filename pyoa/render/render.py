@@ -191,6 +191,13 @@ def _groups_ahead(workers: int) -> int:
     return max(1, SAMPLE_AHEAD * workers)
 
 
+#: Bytes per pixel that a command allocates besides the render, bounded: the
+#: PNG's float64 sRGB conversion, the reference and the float64 copies of
+#: relMSE (``pyoa render``, ``pyoa compare``), the float64 running sum, its
+#: pass and the mean (``pyoa reference``).
+POST_PIXEL_BYTES = 256
+
+
 def check_memory(nbytes: int, what: str, limit: int, fix: str = "render fewer pixels or samples") -> None:
     """Refuse (ValueError) a job that needs more than ``limit`` bytes, before
     anything is allocated; ``fix`` says how to need less."""
@@ -515,3 +522,8 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
                         dims=layout.dims, layout=layout.describe(), seconds=seconds, stats=total, shading=shading,
                         timings=dict(getattr(integ, "timings", {})), integrator=integrator, compiled=compiled,
                         settings=p.settings)
+
+
+def check_job_memory(p, what: str) -> None:
+    """The render's own need plus what the command allocates after it, against the same limit."""
+    check_memory(p.nbytes + p.width * p.height * POST_PIXEL_BYTES, what, p.max_bytes)

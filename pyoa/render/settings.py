@@ -17,6 +17,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+from ..catalogue_types import MAX_UINT32, check_int
+
 #: Camera paths per batch (bounds the working set: ~1 KiB per path).
 BATCH_PATHS = 1 << 16
 
@@ -126,3 +128,15 @@ class RenderSettings:
 def names() -> tuple[str, ...]:
     """The fields of :class:`RenderSettings`, in order."""
     return tuple(f.name for f in dataclasses.fields(RenderSettings))
+
+
+#: Most seeds per sampler of ``pyoa compare --seeds`` and ``pyoa study --seeds``: a typo guard.
+MAX_SEEDS = 1 << 16
+
+
+def check_seeds(seed, seeds) -> list[int]:
+    """The seeds of ``--seed S --seeds N``: S, S+1, ..., S+N-1, all uint32 (``pyoa compare`` and
+    ``pyoa study``)."""
+    n = check_int("--seeds", seeds, 1, MAX_SEEDS)
+    first = check_int("--seed", seed, 0, MAX_UINT32 - n + 1, " (the first of --seeds uint32 seeds)")
+    return list(range(first, first + n))

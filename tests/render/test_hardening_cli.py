@@ -230,7 +230,7 @@ def test_scene_nested_100000_deep(pyoa, tmp_path, old_exr):
     ("reference", ["--out", "missing/r.exr", "--pass-spp", "4"], r"--out: directory 'missing' does not exist"),
 ])
 def test_checks_come_before_the_first_render(tmp_path, monkeypatch, capsys, command, argv, pattern):
-    from pyoa.cli import main
+    from pyoa.commands import main
     from pyoa.render import tiles
 
     monkeypatch.chdir(tmp_path)

@@ -14,8 +14,8 @@ import shutil
 import numpy as np
 import pytest
 
-from pyoa.cli import main
-from pyoa.render import commands, reference
+from pyoa.commands import main
+from pyoa.render import reference
 from pyoa.render.image import read_image
 from pyoa.render.scene import bundled
 
@@ -25,7 +25,7 @@ ARGS = ["--size", "8", "8", "--pass-spp", "4", "-q"]
 
 def interrupt(monkeypatch, argv, fail_at):
     record_passes(monkeypatch, fail_at)
-    with pytest.raises(SystemExit, match="^130$"):  # pyoa.cli: Ctrl-C is exit status 130
+    with pytest.raises(SystemExit, match="^130$"):  # pyoa.commands: Ctrl-C is exit status 130
         main(["reference", *argv])
 
 

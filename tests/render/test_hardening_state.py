@@ -420,8 +420,8 @@ def test_running_out_of_memory_is_one_line(tmp_path):
     code = f"""
         import resource
         import embreex
-        import pyoa.render.commands, pyoa.render.integrator
-        from pyoa.cli import main
+        import pyoa.commands.render, pyoa.render.integrator
+        from pyoa.commands import main
         from pyoa.render.image import check_output
         check_output({str(out)!r}, "--out", (".exr",))  # loads OpenImageIO's EXR writer
         size = int(next(l for l in open("/proc/self/status") if l.startswith("VmSize")).split()[1]) * 1024

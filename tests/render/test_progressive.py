@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pyoa import catalogue
-from pyoa.cli import main
+from pyoa.commands import main
 from pyoa.render import progressive
 from pyoa.render.image import read_image
 from pyoa.render.progressive import block_ends, render_progressive, state_path

@@ -1,5 +1,5 @@
 """The renderer's command line: ``pyoa render``, ``pyoa compare``, ``pyoa reference``
-(:mod:`pyoa.render.commands`), run in-process through :func:`pyoa.cli.main`."""
+(:mod:`pyoa.commands.render`), run in-process through :func:`pyoa.commands.main`."""
 
 from __future__ import annotations
 
@@ -10,8 +10,9 @@ import re
 import numpy as np
 import pytest
 
-from pyoa.cli import main
-from pyoa.render import commands, reference, tiles
+from pyoa.commands import main
+from pyoa.commands import render as render_commands
+from pyoa.render import reference, tiles
 from pyoa.render import image as image_mod
 from pyoa.render.image import read_image, rel_mse, write_exr
 from pyoa.render.render import render
@@ -387,7 +388,7 @@ def test_reference_resumes_after_an_interruption(tmp_path, monkeypatch):
     full = read_image(tmp_path / "full.exr")
 
     calls = record_passes(monkeypatch, fail_at=2)
-    with pytest.raises(SystemExit, match="^130$"):  # pyoa.cli: Ctrl-C is exit status 130
+    with pytest.raises(SystemExit, match="^130$"):  # pyoa.commands: Ctrl-C is exit status 130
         main(["reference", *REF_ARGS, "--out", str(out)])
     assert calls == [reference.pass_seed(0, 0), reference.pass_seed(0, 1)]
     assert state.exists() and not out.exists()
@@ -450,14 +451,14 @@ def test_compare_figure_panels_hold_the_error_map():
     rng = np.random.default_rng(4)
     ref = rng.random((10, 14, 3)).astype(np.float32)
     img = (ref + rng.normal(0, 0.1, ref.shape)).astype(np.float32)
-    full, err, crop, k = commands.figure_panels(img, ref, (2, 3, 5, 4))
+    full, err, crop, k = render_commands.figure_panels(img, ref, (2, 3, 5, 4))
     assert k == 1 and full.shape == img.shape and crop.shape == (4, 5, 3)
     want = ((img.astype(np.float64) - ref) ** 2 / (ref.astype(np.float64) ** 2 + 1e-2)).mean(axis=2)
     np.testing.assert_allclose(err, want, rtol=1e-12)
     assert float(err.mean()) == pytest.approx(rel_mse(img, ref), rel=1e-6)
-    big = np.ones((commands.FIGURE_SIDE * 2 + 1, 10, 3), np.float32)
-    full, err, crop, k = commands.figure_panels(big, big, (0, 0, 4, 4))
-    assert k == 3 and full.shape == ((2 * commands.FIGURE_SIDE + 1) // 3, 10 // 3, 3) and crop.shape == (4, 4, 3)
+    big = np.ones((render_commands.FIGURE_SIDE * 2 + 1, 10, 3), np.float32)
+    full, err, crop, k = render_commands.figure_panels(big, big, (0, 0, 4, 4))
+    assert k == 3 and full.shape == ((2 * render_commands.FIGURE_SIDE + 1) // 3, 10 // 3, 3) and crop.shape == (4, 4, 3)
 
 
 def test_compare_takes_the_reference_size_and_render_defaults_to_121(tmp_path, capsys, reference16):
@@ -469,11 +470,11 @@ def test_compare_takes_the_reference_size_and_render_defaults_to_121(tmp_path, c
         row = next(csv.DictReader(fh))
     img = render(load("cornell"), sampler="bose", spp=4, seed=0, width=16, height=16).image
     assert float(row["relmse"]) == pytest.approx(rel_mse(img, read_image(reference16)), rel=1e-9)
-    from pyoa.render import provenance
+    from pyoa.render.image import read_attributes
 
     out = tmp_path / "r.exr"
     assert main(["render", "dof7d", "--size", "8", "8", "--out", str(out), "-q"]) == 0
-    assert provenance.read(out)["spp"] == 121
+    assert read_attributes(out)["spp"] == 121
     assert main(["render", "dof7d", "--size", "8", "8", "--sampler", "sobol", "--out", str(out)]) == 0
-    assert provenance.read(out)["spp"] == 128
+    assert read_attributes(out)["spp"] == 128
     assert "sobol has no 121-sample set; using its nearest valid count, 128" in capsys.readouterr().err
