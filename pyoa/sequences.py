@@ -1,9 +1,10 @@
 """Tables of the low-discrepancy sequences: Halton's prime bases and Sobol's
 direction numbers.
 
-Both are built once per process and shared by the three implementations (the
-pure-Python reference reads them as Python ints, NumPy as uint32 arrays, the
-OpenCL kernels from a buffer), so the implementations cannot disagree on them.
+Both are built once per process and shared by every implementation (the
+pure-Python reference reads them as Python ints, NumPy and Dr.Jit as uint32
+arrays, the C headers and OpenCL kernels from a buffer), so the
+implementations cannot disagree on them.
 
 Sobol direction numbers are never invented here: the primitive polynomials and
 initial direction numbers are the Joe-Kuo ``new-joe-kuo-6.21201`` table [1]_
