@@ -45,7 +45,7 @@ import numpy as np
 
 from .. import catalogue
 from .image import check_finite, write_exr, write_png
-from .integrator import RENDERER_VERSION, Stats
+from .integrator import Stats
 from .provenance import describe, printable
 from .render import plan, render
 from .settings import RenderSettings
@@ -55,7 +55,6 @@ from .state import (
     describe_size,
     read_state,
     saved_key,
-    scene_digest,
     state_path,
     write_state,
 )
@@ -95,11 +94,8 @@ def check_progressive(name: str) -> None:
     if entry.progressive:
         return
     ok = ", ".join(n for n, c in catalogue.SAMPLERS.items() if c.progressive)
-    why = ("an orthogonal array is stratified only as a whole (all N samples): its first samples are no smaller "
-           "array (bose's first s samples share one stratum of dimension 0), so its intermediate images would be "
-           "poor" if entry.family == "oa" else
-           "its grid is stratified only at the full count, not in its prefixes")
-    raise ValueError(f"{entry.name} cannot render progressively: {why}; progressive samplers: {ok}")
+    raise ValueError(f"{entry.name} cannot render progressively: {entry.why_not_progressive}; progressive "
+                     f"samplers: {ok}")
 
 
 def _describe_change(saved: dict, key: dict) -> str:
@@ -271,10 +267,10 @@ def render_progressive(scene, settings: RenderSettings | None = None, /, *, out,
     smp = p.sampler
     # every block renders the whole film with the planned sampler (its base chosen once)
     settings = p.settings.replace(width=p.width, height=p.height, spp=smp.spp, base=smp.base)
-    key = dict(version=STATE_VERSION, renderer=RENDERER_VERSION, scene=scene_digest(scene), width=p.width,
-               height=p.height, max_depth=p.layout.max_depth, sampler=smp.name, base=smp.base, seed=smp.seed,
-               filter=settings.filter, first=list(p.layout.names), shading=p.shading,
-               spp=None if entry.spp_invariant else smp.spp)
+    # the render's identity; a sampler whose values do not depend on spp continues at any count
+    key = dict(version=STATE_VERSION, **p.identity(scene))
+    if entry.spp_invariant:
+        key["spp"] = None
     meta = describe(scene, p, kind="progressive render", command=command)
     total, done = None, 0
     if resume and state.exists():

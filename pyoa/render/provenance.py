@@ -74,17 +74,16 @@ def describe(scene, p, *, kind: str, command: str | None = None, shading: str | 
     reference's ``spp``). Values are str or int."""
     from .. import __version__
     from ..hostcpu import host_cpu
-    from .integrator import RENDERER_VERSION
-    from .state import scene_digest
 
-    smp = p.sampler
-    meta = {"kind": kind, "scene": scene.name, "scene_file": str(scene.path), "scene_sha256": scene_digest(scene),
-            "width": p.width, "height": p.height, "sampler": smp.name, "spp": smp.spp, "seed": int(smp.seed)}
-    if smp.base is not None:
-        meta["base"] = int(smp.base)
+    ident = p.identity(scene)  # the render's identity (pyoa.render.render.Plan.identity), as header attributes
+    meta = {"kind": kind, "scene": scene.name, "scene_file": str(scene.path), "scene_sha256": ident["scene"],
+            "width": ident["width"], "height": ident["height"], "sampler": ident["sampler"], "spp": ident["spp"],
+            "seed": int(ident["seed"])}
+    if ident["base"] is not None:
+        meta["base"] = int(ident["base"])
     meta.update({k: v for k, v in extra.items() if v is not None})
-    meta.update({"max_depth": p.layout.max_depth, "filter": p.settings.filter, "shading": shading or p.shading,
-                 "layout": p.layout.describe(), "renderer": RENDERER_VERSION, "version": __version__,
+    meta.update({"max_depth": ident["max_depth"], "filter": ident["filter"], "shading": shading or ident["shading"],
+                 "layout": p.layout.describe(), "renderer": ident["renderer"], "version": __version__,
                  "git": git_revision(), "cpu": host_cpu().describe()})
     if command:
         meta["command"] = command

@@ -29,14 +29,12 @@ from pathlib import Path
 import numpy as np
 
 from .image import check_finite, pixel_digest, write_exr
-from .integrator import RENDERER_VERSION
 from .settings import RenderSettings
 from .state import (
     BadState,
     check_state_file,
     describe_size,
     read_state_arrays,
-    scene_digest,
     state_path,
     write_state,
 )
@@ -138,9 +136,11 @@ def reference_key(scene, p, *, pass_spp: int, passes: int, seed: int) -> dict:
     passes planned as ``p`` (:func:`~pyoa.render.render.plan` of one pass)
     (the backend and the engine do not: every backend gives the same
     samples, every engine the same images)."""
-    return dict(version=STATE_VERSION, renderer=RENDERER_VERSION, scene=scene_digest(scene), width=p.width,
-                height=p.height, max_depth=p.layout.max_depth, sampler=p.sampler.name, pass_spp=pass_spp,
-                passes=passes, seed=seed, filter=p.settings.filter, first=list(p.layout.names), shading=p.shading)
+    key = dict(version=STATE_VERSION, **p.identity(scene), pass_spp=pass_spp, passes=passes)
+    # a reference is its passes: their count, size and seed replace the one pass's spp (and sobol has no base)
+    del key["spp"], key["base"]
+    key["seed"] = seed
+    return key
 
 
 def _total_spp(key: dict):

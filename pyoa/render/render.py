@@ -29,9 +29,10 @@ from ..samplers import ENV_MAX_BYTES, default_max_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
 from ..units import format_bytes
 from .camera import check_filter
-from .integrator import Integrator, Stats
+from .integrator import RENDERER_VERSION, Integrator, Stats
 from .layout import MAX_DEPTH, Layout
 from .settings import BATCH_PATHS, RenderSettings
+from .state import scene_digest
 
 #: Working memory of one camera path in flight, besides its row of sampler
 #: values: measured peaks are ~0.3 KiB (compiled shading) and ~1.1 KiB (NumPy
@@ -245,6 +246,20 @@ class Plan:
         other processes: every worker renders this process's shading, not
         its own ``$PYOA_SHADING`` (one image, whatever the workers' setup)."""
         return self.settings.replace(shading=self.shading)
+
+    def identity(self, scene) -> dict:
+        """What makes two renders of ``scene`` the same work: every input that changes a bit of the
+        image (the renderer's version, the scene's digest, the film, the path length, the sampler with
+        its count, base and seed, the filter, the layout of the dimensions, the shading), and nothing
+        that does not (threads, backend, device, engine, batch size: each gives the same bits).
+
+        The one definition that a progressive render's state, a reference's state and an image's
+        header (:mod:`pyoa.render.provenance`) build on, so that they cannot disagree on what "the
+        same render" means."""
+        smp = self.sampler
+        return dict(renderer=RENDERER_VERSION, scene=scene_digest(scene), width=self.width, height=self.height,
+                    max_depth=self.layout.max_depth, sampler=smp.name, spp=smp.spp, base=smp.base, seed=smp.seed,
+                    filter=self.settings.filter, first=list(self.layout.names), shading=self.shading)
 
 
 def plan(scene, settings: RenderSettings | None = None, /, *, threads: int | None = None, **changes) -> Plan:
