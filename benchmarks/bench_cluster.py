@@ -16,8 +16,8 @@ Measures, in one process, interleaved over ``--rounds`` rounds:
 
 Every image is checked bit-identical to the in-process one. Results go to
 ``benchmarks/results/cluster.json`` and ``.md`` and into
-``docs/distributed.md`` between ``<!-- cluster-speedup:begin -->`` and
-``<!-- cluster-speedup:end -->``. This machine's speed drifts 15-40 %
+``docs/distributed.md``'s marked section ``cluster-speedup``
+(``benchmarks/marked.py``), made from ``cluster.json`` by :func:`section`. This machine's speed drifts 15-40 %
 between processes, so only ratios measured in the same run are quoted.
 
 Usage::
@@ -39,7 +39,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import REPO, machine, replace_section, write_text  # noqa: E402
+import marked  # noqa: E402
+from common import REPO, machine, write_text  # noqa: E402
 
 from pyoa import cluster  # noqa: E402
 from pyoa.render.scene import load  # noqa: E402
@@ -50,7 +51,29 @@ from pyoa.study import Job, study_task  # noqa: E402
 
 OUT = REPO / "benchmarks" / "results"
 DOC = REPO / "docs" / "distributed.md"
-BEGIN, END = "<!-- cluster-speedup:begin -->", "<!-- cluster-speedup:end -->"
+SECTION = "cluster-speedup"
+
+
+def section(result: dict) -> str:
+    """The section of docs/distributed.md, from ``cluster.json``'s contents."""
+    meta, times, stimes = result["machine"], result["render_seconds"], result["study_seconds"]
+    med = {k: statistics.median(v) for k, v in times.items()}
+    smed = {k: statistics.median(v) for k, v in stimes.items()}
+    paths = result["size"] * result["size"] * result["spp"]
+    lines = [f"Measured by `python benchmarks/bench_cluster.py` on {meta['cpu']}, {meta['cpu_count']} cores, "
+             f"{result['rounds']} interleaved rounds in one process, medians (`benchmarks/results/cluster.json`). "
+             "Every cluster image and study row was checked bit-identical to the in-process one.", "",
+             f"| engine | render: `{result['scene']}` {result['size']} x {result['size']}, bose {result['spp']} spp | "
+             f"paths/s | speed-up | study: {result['study_renders']} renders of 64 x 64 | speed-up |",
+             "|---|---:|---:|---:|---:|---:|"]
+    for k in times:
+        lines.append(f"| {k} | {med[k]:.2f} s | {paths / med[k] / 1e6:.2f} M | "
+                     f"{med['1 worker'] / med[k]:.2f}x | {smed[k]:.2f} s | {smed['1 worker'] / smed[k]:.2f}x |")
+    lines += ["", "Speed-up is against 1 worker. Starting a local cluster took "
+              + ", ".join(f"{v:.1f} s ({k})" for k, v in result["cluster_start_seconds"].items())
+              + "; the first render on it pays each worker's scene load, integrator setup and numba compilation "
+                "(not in the table)."]
+    return "\n".join(lines) + "\n"
 
 
 def study_jobs(scene: str) -> list[Job]:
@@ -111,31 +134,14 @@ def main(argv=None) -> int:
             print(f"round {r + 1}: " + ", ".join(f"{k} {v[-1]:.2f} s / {stimes[k][-1]:.2f} s"
                                                   for k, v in times.items()), flush=True)
     meta = machine()
-    paths = args.size * args.size * args.spp
-    med = {k: statistics.median(v) for k, v in times.items()}
-    smed = {k: statistics.median(v) for k, v in stimes.items()}
     result = {"machine": meta, "scene": args.scene, "size": args.size, "spp": args.spp, "rounds": args.rounds,
               "render_seconds": times, "study_seconds": stimes, "cluster_start_seconds": starts,
               "study_renders": len(jobs)}
     OUT.mkdir(parents=True, exist_ok=True)
     write_text(OUT / "cluster.json", json.dumps(result, indent=1) + "\n")
-    lines = [BEGIN, "",
-             f"Measured by `python benchmarks/bench_cluster.py` on {meta['cpu']}, {meta['cpu_count']} cores, "
-             f"{args.rounds} interleaved rounds in one process, medians (`benchmarks/results/cluster.json`). "
-             "Every cluster image and study row was checked bit-identical to the in-process one.", "",
-             f"| engine | render: `{args.scene}` {args.size} x {args.size}, bose {args.spp} spp | paths/s | "
-             f"speed-up | study: {len(jobs)} renders of 64 x 64 | speed-up |",
-             "|---|---:|---:|---:|---:|---:|"]
-    for k in times:
-        lines.append(f"| {k} | {med[k]:.2f} s | {paths / med[k] / 1e6:.2f} M | "
-                     f"{med['1 worker'] / med[k]:.2f}x | {smed[k]:.2f} s | {smed['1 worker'] / smed[k]:.2f}x |")
-    lines += ["", "Speed-up is against 1 worker. Starting a local cluster took "
-              + ", ".join(f"{v:.1f} s ({k})" for k, v in starts.items())
-              + "; the first render on it pays each worker's scene load, integrator setup and numba compilation "
-                "(not in the table).", "", END]
-    text = "\n".join(lines) + "\n"
+    text = section(result)
     write_text(OUT / "cluster.md", text)
-    replace_section(DOC, BEGIN, END, text, before="\n### What limits")
+    marked.write(DOC, {SECTION: marked.block_body(text)})
     print(text)
     return 0
 

@@ -119,7 +119,9 @@ time and the machine's description (and, from schema 3,
 with ``compute_ceiling_values_per_s`` and ``of_compute_ceiling`` on the
 opencl rows), and a Markdown table beside it with the same stem
 (``generate.md``); both are written atomically. The table is also printed
-at the end.
+at the end. Then the docs' marked sections made from that file, if any are
+(``update_docs.after``: ``generate-vector.json`` and the files the README's
+table quotes).
 
 Usage::
 
@@ -158,6 +160,8 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared with bench_render.py
 import peers  # noqa: E402
 from common import loadavg, log, machine, machine_lines, write_text  # noqa: E402
+import update_docs  # noqa: E402
+
 DEFAULT_OUT = REPO / "benchmarks" / "results" / "generate.json"
 FULL_PIXELS = 65536
 QUICK_PIXELS = 4096
@@ -781,6 +785,8 @@ def main(argv=None) -> int:
     print()
     print(md, end="")
     print(f"\nwrote {out_json} and {out_md} ({report['total_s']:.0f} s)")
+    for page in update_docs.after(out_json):  # the docs' sections made from this file
+        print(f"wrote {page}")
     ok = any(r["status"] == "ok" for r in results)
     mismatch = any(not same for same in bits_match.values())
     return 0 if ok and not mismatch else 1

@@ -79,7 +79,9 @@ renderer ships without), ``-I pyoa.get_include() -I DIR/include``.
 Output: ``benchmarks/results/openqmc.json`` (every round's ns per value,
 statistics, ratios, vectorization report, compiler, flags, CPU, OpenQMC's
 version and the git tree id of its ``include/``) and ``openqmc.md`` beside
-it; both written atomically. Not part of the test suite (OpenQMC is not
+it; both written atomically, then the marked sections of docs/performance.md
+made from ``openqmc.json`` and ``openqmc-clang.json`` (``update_docs.after``).
+Not part of the test suite (OpenQMC is not
 installed in CI): run it by hand::
 
     git clone --depth 1 --branch v0.7.1 https://github.com/AcademySoftwareFoundation/openqmc /tmp/openqmc
@@ -117,6 +119,7 @@ except ImportError as _exc:  # pragma: no cover - environment problem
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "benchmarks"))
 from common import _cpu, _git, loadavg, log, write_text  # noqa: E402
+import update_docs  # noqa: E402
 
 SOURCE = REPO / "benchmarks" / "openqmc" / "bench.cpp"
 DEFAULT_OUT = REPO / "benchmarks" / "results" / "openqmc.json"
@@ -664,6 +667,8 @@ def run(args: argparse.Namespace) -> int:
     print()
     print(md, end="")
     print(f"\nwrote {out_json} and {out_md} ({rep['total_s']:.0f} s)")
+    for page in update_docs.after(out_json):  # the docs' sections made from this file
+        print(f"wrote {page}")
     return 0
 
 

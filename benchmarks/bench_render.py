@@ -40,7 +40,8 @@ sampler's kernels for new call shapes, excluded; the heap it freed
 returned to the OS first), against the stated bound of docs/performance.md.
 
 Output: ``benchmarks/results/render.json`` and ``render.md`` (``--out``),
-written atomically.
+written atomically, then the docs' marked sections made from ``render.json``
+(``update_docs.after``: README, docs/performance.md).
 
 Usage::
 
@@ -69,6 +70,7 @@ sys.path.insert(0, str(REPO / "benchmarks"))  # peers.py and common.py, shared w
 import numpy as np  # noqa: E402
 import peers  # noqa: E402
 from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, write_text  # noqa: E402
+import update_docs  # noqa: E402
 from numba import njit  # noqa: E402
 
 from pyoa.render import embree  # noqa: E402
@@ -548,6 +550,8 @@ def main(argv=None) -> int:
     md = markdown(report, time.perf_counter() - t_start)
     write_text(out.with_suffix(".md"), md)
     print(md)
+    for page in update_docs.after(out):  # the docs' sections made from this file
+        print(f"wrote {page}")
     return 0
 
 

@@ -221,34 +221,3 @@ def write_csv(path: Path, rows: list[dict]) -> None:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-
-
-def publish_section(page: Path, begin: str, end: str, body: str, *, quick_dir: Path | None = None,
-                    say: Callable[[str], None] = print, untouched: str = "docs/results.md") -> bool:
-    """A study's section: into ``page`` (:func:`replace_section`), or, for a
-    quick run (``quick_dir`` given), into ``quick_dir/section.md`` with the
-    page left alone. Returns whether the page was written."""
-    if quick_dir is not None:
-        write_text(quick_dir / "section.md", body)
-        say(f"wrote {quick_dir / 'section.md'} (quick: {untouched} untouched)")
-        return False
-    replace_section(page, begin, end, body)
-    say(f"wrote the section into {page}")
-    return True
-
-
-def replace_section(path: Path, begin: str, end: str, body: str, before: str = "\n---\n") -> None:
-    """Put ``body`` (which starts with ``begin`` and ends with ``end``) into the page ``path``: in place of
-    the text between the markers if the page has them, else before the last ``before`` (a page footer or
-    the heading that follows), else at the end. A study rewrites its own section and nothing else."""
-    page = path.read_text()
-    if begin in page and end in page:
-        a, b = page.index(begin), page.index(end) + len(end)
-        page = page[:a] + body.rstrip("\n") + page[b:]
-    else:
-        cut = page.rfind(before)
-        if cut >= 0:
-            page = page[:cut + 1] + body + "\n" + page[cut + 1:]
-        else:
-            page = page.rstrip("\n") + "\n\n" + body
-    write_text(path, page)

@@ -28,13 +28,10 @@ Three parts, each timed and written to ``docs/results/faure/``:
 3. ``throughput``: ``benchmarks/bench_generate.py`` on Bose, faure and sobol
    in one process (PoCL and NumPy).
 
-Then ``section`` writes the results into ``docs/results.md`` between
-``<!-- faure-study:begin -->`` and ``<!-- faure-study:end -->`` (replacing an
-earlier version of the section, or inserting it before the page's footer).
-
-``benchmarks/make_results.py`` rewrites ``docs/results.md`` whole and does not
-know this section: after it, run ``python benchmarks/faure_study.py --parts
-section`` to put the section back (from the files in ``docs/results/faure/``).
+Then ``section`` writes the results into ``docs/results.md``'s marked section
+``faure-study`` (``benchmarks/marked.py``; ``benchmarks/update_docs.py``
+writes it again from the files in ``docs/results/faure/``, and
+``benchmarks/make_results.py``, which rewrites the rest of the page, keeps it).
 
 A full run took about 40 minutes on a 2-core AMD EPYC shared with other work
 (integrands 2.5 minutes on a quiet machine, renders 31 minutes with 4 seeds,
@@ -69,7 +66,8 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
-from common import publish_section, write_csv, write_text
+import marked
+from common import write_csv, write_text
 
 import pyoa
 from pyoa import analysis, catalogue
@@ -79,7 +77,7 @@ from pyoa.samplers import trial_options
 
 OUT = REPO / "docs" / "results" / "faure"
 RESULTS_MD = REPO / "docs" / "results.md"
-BEGIN, END = "<!-- faure-study:begin -->", "<!-- faure-study:end -->"
+SECTION = "faure-study"  # the marked section of docs/results.md
 PARTS = ("integrands", "renders", "throughput", "section")
 
 
@@ -1009,10 +1007,11 @@ better, with 1024 trials a ratio is known to about +-6 %):
 """
 
 
-def part_section(args, timings: dict) -> None:
+def section_text(out: Path, timings: dict) -> str:
+    """The results page's section from the saved parts in ``out`` (``timings``: this run's parts, in s)."""
     parts = []
     for name in ("integrands", "renders", "throughput"):
-        p = OUT / f"{name}.md"
+        p = out / f"{name}.md"
         if p.exists():
             parts.append(p.read_text())
     total = ", ".join(f"{k} {v:.0f} s" for k, v in timings.items())
@@ -1023,9 +1022,17 @@ def part_section(args, timings: dict) -> None:
              "b^2 samples are a strength-2 orthogonal array like `bose` at s = b, its first b^3 a "
              "strength-3 one, and a pixel's i-th sample does not depend on spp. This section measures "
              "what that buys and costs.")
-    body = "\n".join([BEGIN, "## faure: progressive orthogonal arrays", "", intro, "", INTERPRETATION, *parts,
-                      footer, END, ""])
-    publish_section(RESULTS_MD, BEGIN, END, body, quick_dir=OUT if args.quick else None)
+    return "\n".join(["## faure: progressive orthogonal arrays", "", intro, "", INTERPRETATION, *parts, footer])
+
+
+def part_section(args, timings: dict) -> None:
+    text = section_text(OUT, timings)
+    if args.quick:  # a smoke run leaves the page alone
+        write_text(OUT / "section.md", text)
+        print(f"wrote {OUT / 'section.md'} (quick: docs/results.md untouched)")
+    else:
+        changed = marked.write(RESULTS_MD, {SECTION: marked.block_body(text)})
+        print(f"{'wrote the section into' if changed else 'the section is unchanged in'} {RESULTS_MD}")
 
 
 def main(argv=None) -> int:

@@ -4,6 +4,10 @@ convergence studies and render comparisons), with every figure it shows.
 
 Everything is computed here, from the public API and the ``pyoa`` commands;
 nothing is copied from elsewhere. Figures and tables go to ``docs/results/``.
+The render study's section is a marked section (``benchmarks/marked.py``),
+and so are the sections of ``faure_study.py`` and ``mitsuba_study.py``,
+which this script keeps as they stand (``benchmarks/update_docs.py`` writes
+all three again from their saved results, in seconds).
 A full run takes about 8 minutes on a 2-core machine (6 when the render
 references in docs/results/ already exist, which it then reuses; it prints the time of each part); ``--quick`` makes small versions of everything in about a
 minute (marked as such on the page, for checking the script itself).
@@ -24,6 +28,10 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
+
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+import marked  # noqa: E402
 
 from pyoa import analysis, catalogue  # noqa: E402
 from pyoa.atomic import atomic_path  # noqa: E402
@@ -205,7 +213,18 @@ def part_renders(page: Page) -> None:
     import render_study
 
     text = render_study.run(quick=page.quick, workers=2, seeds=8)
-    page.add(*text.rstrip("\n").split("\n"), "")
+    page.add(marked.block(render_study.SECTION, text), "")
+
+
+#: The sections other scripts write into the page: kept from the page as it was (empty on a new page).
+KEPT = ("faure-study", "mitsuba-study")
+
+
+def part_kept(page: Page, old: Path) -> None:
+    text = old.read_text(encoding="utf-8") if old.exists() else ""
+    have = marked.sections(text, str(old))
+    for name in KEPT:  # markers and all, so that a hand edit stays visible to the docs test
+        page.add(text[slice(*have[name].outer)] if name in have else marked.block(name, ""), "")
 
 
 def main(argv=None) -> int:
@@ -223,6 +242,7 @@ def main(argv=None) -> int:
     slopes = part_convergence(page)
     part_error_spectra(page)
     part_renders(page)
+    part_kept(page, Path(args.out))
     total = time.perf_counter() - page.t0
     reused = (f" The render references of {', '.join(page.reused)} were reused from an earlier run "
               "(delete docs/results/*-reference.exr to re-render them: about 6 more minutes)."

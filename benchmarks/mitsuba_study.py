@@ -43,14 +43,12 @@ Parts, each written to ``docs/results/mitsuba/``:
 4. ``figure``: ``samplers.png``, seed 0 of ``cornell-dof`` with Mitsuba's
    ``independent``, ``multijitter``, ``orthogonal`` and pyoa's ``bose``,
    ``bush`` and ``faure``, with the reference.
-5. ``section``: the speed, errors and integrand markdown into ``docs/results.md``
-   between ``<!-- mitsuba-study:begin -->`` and ``<!-- mitsuba-study:end -->``
-   (or as a new section before the page's footer), and a "Mitsuba plugin"
-   paragraph into ``docs/performance.md`` between
-   ``<!-- mitsuba-plugin:begin -->`` and ``<!-- mitsuba-plugin:end -->``.
-   ``benchmarks/make_results.py`` rewrites ``docs/results.md`` whole: after
-   it, ``python benchmarks/mitsuba_study.py --parts section`` puts the
-   section back from the saved files.
+5. ``section``: the speed, errors and integrand markdown into
+   ``docs/results.md``'s marked section ``mitsuba-study``, and a "Mitsuba
+   plugin" paragraph into ``docs/performance.md``'s ``mitsuba-plugin``
+   (``benchmarks/marked.py``; ``benchmarks/update_docs.py`` writes both
+   again from the saved files, and ``benchmarks/make_results.py``, which
+   rewrites the rest of the results page, keeps the first).
 
 Dr.Jit's LLVM backend needs an LLVM >= 16 (Debian's ``libllvm19``): the
 environment is set as ``benchmarks/peers.py`` sets it, before Mitsuba is
@@ -85,15 +83,14 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
 import peers
-from common import publish_section, replace_section, write_csv, write_text
+import figures
+from common import write_csv, write_text
 
 from pyoa.atomic import atomic_path
 
 OUT = REPO / "docs" / "results" / "mitsuba"
-RESULTS_MD = REPO / "docs" / "results.md"
-PERFORMANCE_MD = REPO / "docs" / "performance.md"
-BEGIN, END = "<!-- mitsuba-study:begin -->", "<!-- mitsuba-study:end -->"
-PERF_BEGIN, PERF_END = "<!-- mitsuba-plugin:begin -->", "<!-- mitsuba-plugin:end -->"
+#: The marked sections this study writes: in docs/results.md, and in docs/performance.md.
+SECTION, PERF_SECTION = "mitsuba-study", "mitsuba-plugin"
 PARTS = ("speed", "errors", "integrand", "figure", "section")
 VARIANT = "llvm_ad_rgb"
 MAX_DEPTH = 5
@@ -704,8 +701,11 @@ def interpretation(speed: dict | None, errors: dict | None) -> str:
     if speed:
         ri, ro = speed["bose_over_orthogonal"]["int"], speed["bose_over_orthogonal"]["opaque"]
         s = speed["summary"]
+        m = speed["machine"]
         out.append(
-            f"**Speed.** Rendering `cornell` {speed['size']} x {speed['size']} at 121 spp, pyoa's `bose` ran at "
+            f"**Speed.** Rendering `cornell` {speed['size']} x {speed['size']} at 121 spp ({m['date'][:10]}, "
+            f"{figures.cpu_name(m['cpu']['model_name'])} {m['cpu']['family']}/{m['cpu']['model']}, "
+            f"{m['cpu']['cores']} cores), pyoa's `bose` ran at "
             f"{ri['median']:.2f}x Mitsuba's `orthogonal` (median of {speed['rounds']} per-round ratios, "
             f"{ri['min']:.2f}-{ri['max']:.2f}) with the seed passed as a Python int, and {ro['median']:.2f}x "
             f"({ro['min']:.2f}-{ro['max']:.2f}) with an opaque `mi.UInt32` seed; the goal is {speed['goal']}x. "
@@ -716,7 +716,10 @@ def interpretation(speed: dict | None, errors: dict | None) -> str:
                "No timed render compiled a kernel (the plugin's seed is opaque). ")
             + f"`faure` ran at {s['pyoa faure|opaque']['median'] / s['mitsuba orthogonal|opaque']['median']:.2f}x "
             f"`orthogonal` (opaque seeds), `independent` at "
-            f"{s['mitsuba independent|opaque']['median'] / s['mitsuba orthogonal|opaque']['median']:.2f}x.")
+            f"{s['mitsuba independent|opaque']['median'] / s['mitsuba orthogonal|opaque']['median']:.2f}x."
+            + (f" The errors below were measured earlier ({errors['machine']['date'][:10]}); the plugin's values "
+               "are bit for bit NumPy's (`tests/test_mitsuba.py`), so they stand."
+               if errors and errors["machine"]["date"] < m["date"] else ""))
     if errors:
         parts = []
         for scene, v in scene_means(errors):
@@ -794,42 +797,64 @@ def block_order_effect(errors: dict, before: dict | None) -> str:
     return "\n\n".join(out)
 
 
-def part_section(args) -> None:
-    speed = json.loads((OUT / "speed.json").read_text()) if (OUT / "speed.json").exists() else None
-    errors = json.loads((OUT / "errors.json").read_text()) if (OUT / "errors.json").exists() else None
-    if speed:
-        write_text(OUT / "speed.md", speed_markdown(speed))
-    if errors:
-        write_text(OUT / "errors.md", errors_markdown(errors))
-    parts = [p.read_text() for p in (OUT / "speed.md", OUT / "errors.md", OUT / "integrand.md") if p.exists()]
+def _saved(out: Path, part: str) -> dict | None:
+    path = out / f"{part}.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def section_text(out: Path) -> str:
+    """The results page's section from the saved parts in ``out``."""
+    speed, errors = _saved(out, "speed"), _saved(out, "errors")
+    parts = [speed_markdown(speed) if speed else None, errors_markdown(errors) if errors else None,
+             (out / "integrand.md").read_text() if (out / "integrand.md").exists() else None]
     intro = ("`pyoa/mitsuba.py` registers a Mitsuba 3 sampler plugin, `pyoa`: `import pyoa.mitsuba`, then a "
              "scene's sampler `{\"type\": \"pyoa\", \"sampler\": \"bose\", \"sample_count\": 121}` draws pyoa's "
              "values inside Mitsuba's own kernels (Dr.Jit, LLVM backend). This section compares it with "
              "Mitsuba's own samplers in Mitsuba's renderer: speed, and error at equal spp.")
     fig = ("![Mitsuba's and pyoa's samplers](results/mitsuba/samplers.png)\n\n"
            "Seed 0 of each sampler on `cornell-dof`, relMSE in the titles.\n"
-           if (OUT / "samplers.png").exists() else "")
-    spent = sum(json.loads((OUT / f"{p}.json").read_text()).get("wall_s", 0) for p in ("speed", "errors", "integrand")
-                if (OUT / f"{p}.json").exists())
+           if (out / "samplers.png").exists() else "")
+    spent = sum((_saved(out, p) or {}).get("wall_s", 0) for p in ("speed", "errors", "integrand"))
     footer = (f"Regenerate with `python benchmarks/mitsuba_study.py` (its parts took {spent / 60:.0f} minutes "
-              "here on 2 cores; `--parts "
-              "section` rewrites this section from the saved files in `docs/results/mitsuba/`).")
-    body = "\n".join([BEGIN, "## pyoa inside Mitsuba 3", "", intro, "", interpretation(speed, errors), "",
-                      *parts, fig, footer, END, ""])
-    if not publish_section(RESULTS_MD, BEGIN, END, body, quick_dir=OUT if args.quick else None, say=say,
-                           untouched="docs/results.md and docs/performance.md"):
-        return
+              "here on 2 cores; `python benchmarks/update_docs.py` rewrites this section from the saved files "
+              "in `docs/results/mitsuba/`).")
+    return "\n".join(["## pyoa inside Mitsuba 3", "", intro, "", interpretation(speed, errors), "",
+                      *[p for p in parts if p], fig, footer])
+
+
+def part_section(args) -> None:
+    speed, errors = _saved(OUT, "speed"), _saved(OUT, "errors")
     if speed:
-        write_performance(speed)
+        write_text(OUT / "speed.md", speed_markdown(speed))
+    if errors:
+        write_text(OUT / "errors.md", errors_markdown(errors))
+    text = section_text(OUT)
+    if args.quick:  # a smoke run leaves the pages alone
+        write_text(OUT / "section.md", text)
+        say(f"wrote {OUT / 'section.md'} (quick: docs/results.md and docs/performance.md untouched)")
+        return
+    import update_docs  # this section, and the Mitsuba plugin's paragraph and goal in docs/performance.md
+
+    for page in update_docs.update([SECTION, PERF_SECTION, "mitsuba-goal"] if speed else [SECTION]):
+        say(f"wrote {page}")
 
 
-def write_performance(speed: dict) -> None:
+def goal_text(speed: dict) -> str:
+    """The Mitsuba plugin's cell of docs/performance.md's goals table."""
+    ri, ro = speed["bose_over_orthogonal"]["int"], speed["bose_over_orthogonal"]["opaque"]
+    c = speed["machine"]["cpu"]
+    return (f"{figures.cpu_name(c['model_name'])} {c['family']}/{c['model']}: **{ri['median']:.2f}x** (int seeds, "
+            f"per round {ri['min']:.2f}-{ri['max']:.2f}) and **{ro['median']:.2f}x** (opaque, "
+            f"{ro['min']:.2f}-{ro['max']:.2f})")
+
+
+def performance_text(speed: dict) -> str:
+    """docs/performance.md's "Mitsuba plugin" paragraph from the speed part."""
     ri, ro = speed["bose_over_orthogonal"]["int"], speed["bose_over_orthogonal"]["opaque"]
     s = speed["summary"]
     m = speed["machine"]
     goal = speed["goal"]
-    text = "\n".join([
-        PERF_BEGIN,
+    return "\n".join([
         "### Mitsuba plugin",
         "",
         f"pyoa's samplers also run inside Mitsuba 3 (`pyoa/mitsuba.py`, sampler type `pyoa`), traced into "
@@ -851,11 +876,7 @@ def write_performance(speed: dict) -> None:
         + "Table and per-round ratios: "
         "[docs/results/mitsuba/speed.md](results/mitsuba/speed.md); errors at equal spp: "
         "[Results](results.md#pyoa-inside-mitsuba-3).",
-        PERF_END,
-        "",
     ])
-    replace_section(PERFORMANCE_MD, PERF_BEGIN, PERF_END, text, before="\n## First use of a shape")
-    say(f"wrote the Mitsuba plugin paragraph into {PERFORMANCE_MD}")
 
 
 # ---------------------------------------------------------------------------

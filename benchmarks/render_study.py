@@ -12,6 +12,14 @@ study's tables and figures, and verdicts computed from its numbers (where
 bose beats the best padded sampler, where sobol beats bose, and whether the
 paper's claim holds at each count with its interval).
 
+The section is a marked section (``benchmarks/marked.py``): its begin
+marker records a digest of the text, and ``benchmarks/update_docs.py``
+writes it again from the saved study (``--report-only`` does the same for
+this section alone), with the README's table of headline ratios
+(:func:`headline`). The study's command and the CPU it ran on are kept
+beside its rows, in ``benchmark.json``, so that the section made again on
+another machine, or with other defaults, still says what was rendered where.
+
 ``--quick`` makes a small study under ``docs/results/quick/study`` (git
 ignored) and prints the section instead of writing the page.
 
@@ -31,14 +39,15 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import REPO, machine, replace_section  # noqa: E402
+from common import REPO, machine, write_text  # noqa: E402
 
 import pyoa  # noqa: E402
 from pyoa import commands  # noqa: E402
 from pyoa.study import PADDED, cells, read_rows  # noqa: E402
 
-RESULTS_MD = REPO / "docs" / "results.md"
-BEGIN, END = "<!-- render-study:begin -->", "<!-- render-study:end -->"
+#: The marked sections this study writes: the results page's "Renders", the README's headline ratios.
+SECTION, HEADLINE = "render-study", "render-study-headline"
+STUDY = REPO / "docs" / "results" / "study"
 #: What each scene exercises; its dimension count and path length are read from the renderer's own
 #: layout (dimensions), never written here, so the page cannot drift from what `pyoa render` prints.
 SCENES = {
@@ -49,14 +58,39 @@ SCENES = {
 }
 
 
-def about(scene: str) -> str:
-    """``SCENES[scene]`` with the dimensions and longest path of the scene's layout (as ``pyoa render``
-    prints them)."""
+def layout(scene: str):
+    """The renderer's layout of ``scene`` (its dimensions and longest path, as ``pyoa render`` prints them)."""
     from pyoa.render.render import plan
     from pyoa.render.scene import load
 
-    layout = plan(load(scene), sampler="random", spp=1, width=1, height=1).layout
-    return f"{layout.dims} dimensions, paths of up to {layout.max_depth} segments; {SCENES[scene]}"
+    return plan(load(scene), sampler="random", spp=1, width=1, height=1).layout
+
+
+def about(scene: str) -> str:
+    """``SCENES[scene]`` with the dimensions and longest path of the scene's layout."""
+    lay = layout(scene)
+    return f"{lay.dims} dimensions, paths of up to {lay.max_depth} segments; {SCENES[scene]}"
+
+
+def bose_ratios(by: dict) -> dict:
+    """For one scene's cells (sampler -> spp asked -> cell), at each count bose has: bose's noise-corrected
+    mean relMSE over the best padded sampler's (the one whose interval's lower end is lowest), as
+    ``(name, ratio, lo, hi)``, and over sobol's, as ``(ratio, lo, hi)``: 95 % intervals of
+    :func:`pyoa.analysis.statistics.ratio_ci` (the delta method on the two means)."""
+    from pyoa.analysis.statistics import ratio_ci
+
+    out = {}
+    for asked, c in sorted(by["bose"].items()):
+        padded = [(by[n][asked], n) for n in PADDED if asked in by.get(n, {})]
+        row = {}
+        if padded:
+            best, name = min(padded, key=lambda cn: cn[0].ci()[0])
+            row["padded"] = (name, *ratio_ci(c.values, best.values, shift_a=c.noise, shift_b=best.noise))
+        s = by.get("sobol", {}).get(asked)
+        if s is not None:
+            row["sobol"] = ratio_ci(c.values, s.values, shift_a=c.noise, shift_b=s.noise)
+        out[asked] = row
+    return out
 
 
 def verdicts(table: dict) -> list[str]:
@@ -71,17 +105,14 @@ def verdicts(table: dict) -> list[str]:
         if "bose" not in by:
             continue
         parts, sob = [], []
-        for asked, c in sorted(by["bose"].items()):
-            padded = [(by[n][asked], n) for n in PADDED if asked in by.get(n, {})]
-            if padded:
-                best, name = min(padded, key=lambda cn: cn[0].ci()[0])
-                r, lo, hi = ratio_ci(c.values, best.values, shift_a=c.noise, shift_b=best.noise)
+        for asked, row in bose_ratios(by).items():
+            if "padded" in row:
+                name, r, lo, hi = row["padded"]
                 word = "holds" if hi < 1 else ("does not hold" if lo > 1 else "undecided")
                 claim[word].append(f"{scene} {asked}")
                 parts.append(f"{asked} spp {r:.2f} [{lo:.2f}, {hi:.2f}] vs {name}")
-            s = by.get("sobol", {}).get(asked)
-            if s is not None:
-                r, lo, hi = ratio_ci(c.values, s.values, shift_a=c.noise, shift_b=s.noise)
+            if "sobol" in row:
+                r, lo, hi = row["sobol"]
                 sob.append(f"{asked} spp {r:.2f} [{lo:.2f}, {hi:.2f}]")
         strength3 = []
         for asked, c in sorted(by.get("bush", {}).items()):
@@ -121,14 +152,24 @@ def verdicts(table: dict) -> list[str]:
     return lines
 
 
-def section(out: Path, meta: dict) -> str:
-    """The page section from the study's files."""
-    md = (out / "study.md").read_text()
-    rows = read_rows(out / "study.csv")
+def study_table(out: Path) -> dict:
+    """The study's cells (scene -> sampler -> spp asked -> cell) from its rows, with each reference's noise."""
     settings = json.loads((out / "study.json").read_text())
-    noise = {}
-    for name, s in settings["scenes"].items():
-        noise[name] = tuple(s["noise"]) if s.get("noise") else None
+    noise = {name: tuple(s["noise"]) if s.get("noise") else None for name, s in settings["scenes"].items()}
+    return cells(read_rows(out / "study.csv"), noise)
+
+
+def section(out: Path) -> str:
+    """The page section from the study's files: what was rendered where from ``benchmark.json``, the time
+    from ``study.json``, the tables from ``study.md`` and the verdicts from ``study.csv``."""
+    md = (out / "study.md").read_text()
+    settings = json.loads((out / "study.json").read_text())
+    m = json.loads((out / "benchmark.json").read_text())
+    runs = settings.get("runs", [])
+    spent = sum(r["seconds"] for r in runs)
+    where = "; ".join(sorted({r["where"] for r in runs if r["rendered"]})) or "?"
+    timing = (f"The study (references included) took {spent / 60:.1f} minutes in {len(runs)} run(s) on {where}, "
+              f"{m['cpu']} ({m['cpu_count']} cores).")
     rel = out.relative_to(REPO / "docs") if out.is_relative_to(REPO / "docs") else out
     body = md.split("\n", 2)[2] if md.startswith("# ") else md  # drop the study's own title
     # the study's per-scene headings become this page's subsections
@@ -136,42 +177,71 @@ def section(out: Path, meta: dict) -> str:
     for scene in SCENES:
         body = body.replace(f"### {scene}\n", f"### `{scene}`: {about(scene)}\n\n![{scene}]({rel}/study-{scene}.png)\n",
                             1)
-    table = cells(rows, noise)
-    lines = [BEGIN, "## Renders", "",
-             f"`pyoa study` (`benchmarks/render_study.py`): {meta['what']} Rows: `{rel}/study.csv` (one per "
-             f"render), settings: `{rel}/study.json`. {meta['timing']}", "",
+    lines = ["## Renders", "",
+             f"`pyoa study` (`benchmarks/render_study.py`): {describe(m['argv'])} Rows: `{rel}/study.csv` (one per "
+             f"render), settings: `{rel}/study.json`. {timing}", "",
              f"![error against spp]({rel}/study.png)", "",
              "In plain words (ratios of noise-corrected mean image relMSE with 95 % intervals; below 1 bose "
-             "has less error):", "", *verdicts(table), "", body.strip(), "", END]
+             "has less error):", "", *verdicts(study_table(out)), "", body.strip()]
     return "\n".join(lines) + "\n"
 
 
-def run(*, quick: bool = False, workers: int = 2, seeds: int = 8, report_only: bool = False) -> str:
-    """Run (or resume) the study and return the page section."""
-    out = REPO / "docs" / "results" / ("quick/study" if quick else "study")
-    out.parent.mkdir(parents=True, exist_ok=True)
+#: The README's headline rows: (scene, spp asked).
+HEADLINE_ROWS = (("dof7d", 16), ("dof7d", 1024), ("bounce9d", 1024), ("deep", 1024), ("cornell", 1024))
+
+
+def headline(out: Path = STUDY) -> str:
+    """The README's table: bose over the best padded 2D sampler and over sobol at :data:`HEADLINE_ROWS`."""
+    table = study_table(out)
+    lines = ["| scene | spp | bose / best padded 2D sampler | bose / sobol |", "|---|---:|---:|---:|"]
+    ratios = {scene: bose_ratios(table[scene]) for scene in dict(HEADLINE_ROWS)}
+    for scene, asked in HEADLINE_ROWS:
+        row = ratios[scene][asked]
+        (_, r, lo, hi), (rs, los, his) = row["padded"], row["sobol"]
+        lines.append(f"| {scene} ({layout(scene).dims}D) | {asked} | {r:.2f} [{lo:.2f}, {hi:.2f}] | "
+                     f"{rs:.2f} [{los:.2f}, {his:.2f}] |")
+    return "\n".join(lines)
+
+
+def argv_for(quick: bool, workers: int, seeds: int) -> list[str]:
+    """The ``pyoa study`` command line of the study (published, or ``quick``)."""
+    out = (STUDY.parent / "quick" / "study" if quick else STUDY).relative_to(REPO)
     scenes = ["dof7d", "cornell"] if quick else list(SCENES)
     size, spp, ref_spp = ("16", "16,64", "1024") if quick else ("64", "16,64,256,1024", "16384")
-    seeds_ = "3" if quick else str(seeds)
-    argv = ["study", *scenes, "--samplers", "all", "--spp", spp, "--seeds", seeds_, "--reference-spp", ref_spp,
-            "--size", size, size, "--out", str(out), "-q"]
-    if workers > 0:
-        argv += ["--workers", str(workers)]
-    if not report_only:
-        rc = commands.main(argv)
-        if rc:
-            raise SystemExit(rc)
-    settings = json.loads((out / "study.json").read_text())
-    runs = settings.get("runs", [])
+    argv = ["study", *scenes, "--samplers", "all", "--spp", spp, "--seeds", "3" if quick else str(seeds),
+            "--reference-spp", ref_spp, "--size", size, size, "--out", str(out), "-q"]
+    return argv + (["--workers", str(workers)] if workers > 0 else [])
+
+
+def describe(argv: list[str]) -> str:
+    """What the study renders, in words, and its command."""
+    opt = {k: argv[i + 1] for i, k in enumerate(argv) if k.startswith("--")}
+    scenes = argv[1:argv.index("--samplers")]
+    return (f"{len(scenes)} scenes at {opt['--size']} x {opt['--size']}, every sampler, spp {opt['--spp']}, "
+            f"{opt['--seeds']} seeds, references of {opt['--reference-spp']} spp made by `pyoa reference` passes "
+            f"on the same cluster; command "
+            f"`pyoa {' '.join(a for a in argv if a != '-q')}`.")
+
+
+def study(argv: list[str]) -> Path:
+    """Run (or resume) the study of ``argv`` (its ``--out`` relative to the repository); its command and
+    the CPU it ran on go to ``benchmark.json`` beside it."""
+    i = argv.index("--out") + 1
+    out = REPO / argv[i]
+    out.parent.mkdir(parents=True, exist_ok=True)
+    rc = commands.main([*argv[:i], str(out), *argv[i + 1:]])
+    if rc:
+        raise SystemExit(rc)
     meta = machine()
-    what = (f"{len(scenes)} scenes at {size} x {size}, every sampler, spp {spp}, {seeds_} seeds, references of "
-            f"{ref_spp} spp made by `pyoa reference` passes on the same cluster; command "
-            f"`pyoa {' '.join(a for a in argv if a != '-q').replace(str(REPO) + '/', '')}`.")
-    spent = sum(r["seconds"] for r in runs)
-    where = "; ".join(sorted({r["where"] for r in runs if r["rendered"]})) or "?"
-    when = (f"The study (references included) took {spent / 60:.1f} minutes in {len(runs)} run(s) on {where}, "
-            f"{meta['cpu']} ({meta['cpu_count']} cores).")
-    return section(out, {"what": what, "timing": when})
+    write_text(out / "benchmark.json",
+               json.dumps({"argv": argv, "cpu": meta["cpu"], "cpu_count": meta["cpu_count"]}) + "\n")
+    return out
+
+
+def run(*, quick: bool = False, workers: int = 2, seeds: int = 8, report_only: bool = False) -> str:
+    """Run (or resume, or with ``report_only`` only read) the study; return the page section's text."""
+    argv = argv_for(quick, workers, seeds)
+    return section(REPO / argv[argv.index("--out") + 1] if report_only else study(argv))
 
 
 def main(argv=None) -> int:
@@ -179,14 +249,17 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="a small study, printed, not written to the page")
     ap.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2; 0: in-process)")
     ap.add_argument("--seeds", type=int, default=8)
-    ap.add_argument("--report-only", action="store_true", help="write the section from the saved study")
+    ap.add_argument("--report-only", action="store_true", help="write the sections from the saved study")
     args = ap.parse_args(argv)
-    text = run(quick=args.quick, workers=args.workers, seeds=args.seeds, report_only=args.report_only)
     if args.quick:
-        print(text)
-    else:
-        replace_section(RESULTS_MD, BEGIN, END, text, before="\n<!-- faure-study:begin -->")
-        print(f"wrote the Renders section of {RESULTS_MD}")
+        print(run(quick=True, workers=args.workers, seeds=args.seeds, report_only=args.report_only))
+        return 0
+    if not args.report_only:
+        study(argv_for(False, args.workers, args.seeds))
+    import update_docs
+
+    for page in update_docs.update(names=[SECTION, HEADLINE]):
+        print(f"wrote {page}")
     return 0
 
 
