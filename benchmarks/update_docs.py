@@ -100,6 +100,12 @@ def _mitsuba_goal() -> str:
     return mitsuba_study.goal_text(figures.load(MITSUBA / "speed.json"))
 
 
+def _cluster_speedup() -> str:
+    import bench_cluster
+
+    return bench_cluster.section(figures.load(figures.RESULTS / "cluster.json"))
+
+
 SECTIONS: dict[str, Entry] = {
     # benchmarks/render_study.py: the render study's ratios
     "render-study": Entry((RESULTS_PAGE,), (STUDY,), _render_study),
@@ -124,6 +130,8 @@ SECTIONS: dict[str, Entry] = {
     # benchmarks/bench_openqmc.py: the C headers against OpenQMC
     "openqmc": Entry((PERFORMANCE,), figures.OPENQMC, figures.openqmc_table),
     "openqmc-goal": Entry((PERFORMANCE,), figures.OPENQMC, figures.openqmc_goal, inline=True),
+    # benchmarks/bench_cluster.py: a study's speed-up on a local cluster
+    "cluster-speedup": Entry((REPO / "docs" / "distributed.md",), (figures.RESULTS / "cluster.json",), _cluster_speedup),
 }
 #: Every page that holds marked sections.
 PAGES = tuple(sorted({p for e in SECTIONS.values() for p in e.pages}))
