@@ -31,123 +31,70 @@ from . import pmj02_tables, sequences
 from ._numpy import baselines as _numpy_baselines
 from ._numpy import pmj02 as _numpy_pmj02
 from ._numpy import zsobol as _numpy_zsobol
-from .catalogue_types import (
-    MAX_DIMS,
-    MAX_SPP,
-    Claim,
-    Construction,
-    Params,
-    SppChoice,
-    nearest,
-    register,
-)
+from .catalogue_types import MAX_SPP, Claim, CountRule, SppChoice, register
+from .params import PointSetParams, SequenceParams
 from .reference import baselines as _reference_baselines
 from .reference import pmj02 as _reference_pmj02
 from .reference import zsobol as _reference_zsobol
 
 
-class AllCounts(Sequence):
-    """Every sample count ``1 .. MAX_SPP`` of a sampler that accepts any N,
-    listed lazily (16.7 million entries)."""
-
-    def __init__(self, make):
-        self._make = make
-
-    def __len__(self):
-        return MAX_SPP
-
-    def __getitem__(self, k):
-        if isinstance(k, slice):
-            return [self._make(n + 1) for n in range(*k.indices(MAX_SPP))]
-        if k < 0:
-            k += MAX_SPP
-        if not 0 <= k < MAX_SPP:
-            raise IndexError(k)
-        return self._make(k + 1)
+#: The listed strata of the samplers of padded pairs, (s, strength, block_dims):
+#: each pair of dimensions stratified on 2 x 2 cells and finer
+PAIRS = (2, 2, 2)
 
 
-class Baseline(Construction):
-    """Base class of the comparison samplers.
+class Baseline(CountRule):
+    """The comparison samplers' family.
 
-    Their implementations are called as ``function(i, j, *shape_args(params),
-    *seed_args(...)[, jitter])``, in the kernels by one ``generate_{function}``
-    kernel each (generated from ``kernel``). They have no offset styles; only
-    the samplers with ``jittered = True`` take a jitter amount.
+    A sequence (:class:`pyoa.params.SequenceParams`) unless the entry is a
+    padded 2D grid (:class:`PointSet`). What a listing shows of one
+    (:meth:`choice`): its :attr:`strata` and, for the powers of two, the
+    exponent. They have no offset styles; only the samplers with ``jittered
+    = True`` take a jitter amount.
     """
 
     family = "baseline"
-    module = "baselines"
-    #: whether the sampler takes a jitter amount
-    jittered = False
-    #: largest number of dimensions
-    max_dims = MAX_DIMS
-    #: sample counts: "any" (1 .. 2**24), "pow2" (powers of two) or "square"
-    counts = "any"
-    #: largest sample count
-    max_spp = MAX_SPP
+    drjit_module = "baselines"
+    #: ``(s, strength, block_dims)`` as a listing shows them (SppChoice, the
+    #: sampler's attributes): ``strength``-dimensional projections of each
+    #: block of ``block_dims`` dimensions stratified into ``s`` strata per
+    #: axis; None: ``(1, 0, max_dims)``, no stratification claimed
+    strata: tuple[int, int, int] | None = None
     #: the vector kernel of kernels/vector.cl (VBASELINE) that computes it, or 0
     vector_kind = 0
 
-    def params(self, spp: int, dims: int | None) -> Params:
-        """Parameters for a valid ``spp`` (see the subclasses)."""
-        return Params(s=1, strength=0, block_dims=self.max_dims, M=spp, dims=dims or 0)
+    def params(self, spp, dims):
+        return SequenceParams(N=spp, dims=dims or 0)
 
-    def detail(self, prm: Params) -> str:
-        return f"2^{prm.M.bit_length() - 1}" if self.counts == "pow2" else ""
+    def choice(self, params):
+        s, strength, block_dims = self.strata or (1, 0, self.max_dims)
+        return SppChoice(params.N, s, strength, block_dims, self.grid(params))
 
-    def _choice(self, spp: int, dims=None) -> SppChoice:
-        prm = self.params(spp, dims)
-        return SppChoice(spp, prm.s, prm.strength, prm.block_dims, self.detail(prm))
+    def grid(self, params) -> str:
+        """The listing's detail: ``"2^7"`` for the powers of two, else ``""``."""
+        return f"2^{params.N.bit_length() - 1}" if self.counts == "pow2" else ""
 
-    def _check(self, dims, strength):
-        if strength is not None:
-            raise ValueError(f"{self.name} has no strength parameter (got strength={strength}); "
-                             "strength applies to the orthogonal-array samplers")
-        if dims is not None and dims > self.max_dims:
-            raise ValueError(f"{self.name} supports at most {self.max_dims} dimensions, got dims={dims}"
-                             f"{self.more_dims_hint}")
+    def detail(self, params):
+        grid = self.grid(params)
+        return f"grid {grid}" if grid else ""
 
-    more_dims_hint = ""
+    def spp_table(self, choices):
+        # their grid (if any) instead of s and t
+        return [f"{'spp':>9s} {'grid':>11s}", *(f"{c.spp:9d} {c.detail or '-':>11s}" for c in choices)]
 
-    def valid(self, spp: int) -> bool:
-        if not 1 <= spp <= self.max_spp:
-            return False
-        return self.counts == "any" or spp & (spp - 1) == 0
 
-    def choices(self, dims=None, strength=None):
-        self._check(dims, strength)
-        if self.counts == "any":
-            return AllCounts(lambda n: self._choice(n, dims))
-        return [self._choice(1 << k, dims) for k in range(self.max_spp.bit_length())]
+class PointSet(Baseline):
+    """The padded 2D grids (:class:`pyoa.params.PointSetParams`): every pair of
+    dimensions an ``a x c`` grid with one point per cell, stratified at the
+    full count only. ``jitter`` scales the offset inside the cell."""
 
-    def nearest(self, spp, dims=None, strength=None):
-        self._check(dims, strength)
-        if self.counts == "any":  # every count in [1, max_spp]: the neighbours, not 16.7 million choices
-            near = min(max(int(spp), 0), self.max_spp + 1)
-            return [self._choice(n, dims) for n in (near - 1, near, near + 1) if 1 <= n <= self.max_spp]
-        return nearest(self.choices(dims), spp)
+    jittered = True
 
-    def solve(self, spp, dims, strength):
-        self._check(dims, strength)
-        return self.params(spp, dims) if self.valid(spp) else None
+    def choice(self, params):
+        return SppChoice(params.N, params.a, 2, 2, self.grid(params))
 
-    def invalid(self, spp, dims, strength):
-        if self.counts == "pow2":
-            return f"{spp} is not a power of two in [1, 2^{self.max_spp.bit_length() - 1}]"
-        return f"{spp} is not in [1, 2^24]"
-
-    def options(self, offset, jitter):
-        # no offset styles; a jitter amount only where the sampler has one
-        return (jitter,) if self.jittered else ()
-
-    def shape_args(self, params):
-        return ()
-
-    def test_cases(self):
-        # one sample, a few, the largest count (its last sample), many dimensions
-        few = 12 if self.counts == "any" else 16
-        return [dict(spp=1, dims=1), dict(spp=few, dims=5), dict(spp=self.max_spp, dims=3),
-                dict(spp=4, dims=min(self.max_dims, 600))]
+    def grid(self, params):
+        return f"{params.a}x{params.c}"
 
 
 @register
@@ -171,12 +118,11 @@ class Random(Baseline):
     kernel = "pyoa_sample_random"
     description = "independent uniform random values (no stratification): any N"
 
-    def params(self, spp, dims):
-        return Params(s=1, strength=0, block_dims=1, M=spp, dims=dims or 0)
+    strata = (1, 0, 1)
 
 
 @register
-class Jittered2D(Baseline):
+class Jittered2D(PointSet):
     """``jittered2d``: padded 2D jittered sampling, the paper's "Jittered2D (pad)".
 
     ``spp = m**2``. Dimensions ``(0, 1), (2, 3), ...`` are independent pairs,
@@ -189,7 +135,6 @@ class Jittered2D(Baseline):
 
     name = "jittered2d"
     code = 6
-    jittered = True
     counts = "square"
     vector_kind = 1
     reference = staticmethod(_reference_baselines.jittered2d)
@@ -202,10 +147,7 @@ class Jittered2D(Baseline):
 
     def params(self, spp, dims):
         m = math.isqrt(spp)
-        return Params(s=m, strength=2, block_dims=2, M=1, dims=dims or 0)
-
-    def detail(self, prm):
-        return f"{prm.s}x{prm.s}"
+        return PointSetParams(N=spp, a=m, c=m, dims=dims or 0)
 
     def choices(self, dims=None, strength=None):
         self._check(dims, strength)
@@ -215,11 +157,11 @@ class Jittered2D(Baseline):
         return f"{spp} is not a square m^2 (m <= {math.isqrt(MAX_SPP)})"
 
     def shape_args(self, params):
-        return (params.s, params.dims)
+        return (params.a, params.dims)
 
     def claims(self, params, offset):
         # each pair an m x m jittered grid, each dimension m strata of m points
-        return [Claim("grid", a=params.s, c=params.s), Claim("latin", n=params.s)]
+        return [Claim("grid", a=params.a, c=params.c), Claim("latin", n=params.a)]
 
     def test_cases(self):
         # 1 x 1, an odd dims (a lone last dimension), 4096 x 4096
@@ -227,7 +169,7 @@ class Jittered2D(Baseline):
 
 
 @register
-class CMJ2D(Baseline):
+class CMJ2D(PointSet):
     """``cmj2d``: padded correlated multi-jittered 2D (Kensler 2013), the paper's "CMJ2D (pad)".
 
     Any ``spp``, split into the most nearly square grid ``m x n`` (``m`` the
@@ -241,7 +183,6 @@ class CMJ2D(Baseline):
 
     name = "cmj2d"
     code = 7
-    jittered = True
     vector_kind = 2
     reference = staticmethod(_reference_baselines.cmj2d)
     numpy = staticmethod(_numpy_baselines.cmj2d)
@@ -250,16 +191,13 @@ class CMJ2D(Baseline):
 
     def params(self, spp, dims):
         m = max(d for d in range(1, math.isqrt(spp) + 1) if spp % d == 0)
-        return Params(s=m, strength=2, block_dims=2, M=spp // m, dims=dims or 0)
-
-    def detail(self, prm):
-        return f"{prm.s}x{prm.M}"
+        return PointSetParams(N=spp, a=m, c=spp // m, dims=dims or 0)
 
     def shape_args(self, params):
-        return (params.s, params.M)
+        return (params.a, params.c)
 
     def claims(self, params, offset):
-        return [Claim("grid", a=params.s, c=params.M), Claim("latin", n=params.s * params.M)]
+        return [Claim("grid", a=params.a, c=params.c), Claim("latin", n=params.N)]
 
     def test_cases(self):
         # a prime (1 x N), 10 x 12, a square, the largest prime below 2^24 and 4093 x 4099
@@ -280,6 +218,7 @@ class Sobol02(Baseline):
     """
 
     name = "sobol02"
+    strata = PAIRS
     code = 8
     progressive = True
     counts = "pow2"
@@ -288,11 +227,8 @@ class Sobol02(Baseline):
     kernel = "pyoa_sample_sobol02"
     description = "padded (0,2)-sequence, Owen-scrambled and shuffled per pair: N a power of two"
 
-    def params(self, spp, dims):
-        return Params(s=2, strength=2, block_dims=2, M=spp, dims=dims or 0)
-
     def shape_args(self, params):
-        return (params.M.bit_length() - 1,)
+        return (params.N.bit_length() - 1,)
 
     def constants(self, params):
         return sequences.sobol_matrices()[:2]
@@ -301,7 +237,7 @@ class Sobol02(Baseline):
         return self.name  # the same two dimensions for every count
 
     def claims(self, params, offset):
-        return [Claim("net", n=params.M, prefixes=True), Claim("latin", n=params.M)]
+        return [Claim("net", n=params.N, prefixes=True), Claim("latin", n=params.N)]
 
 
 @register
@@ -367,7 +303,7 @@ class Sobol(Baseline):
 
     def claims(self, params, offset):
         # every dimension a (0,1)-sequence; dimensions 0 and 1 a (0,2)-sequence
-        return [Claim("net", n=params.M, prefixes=True, pairs=1), Claim("latin", n=params.M)]
+        return [Claim("net", n=params.N, prefixes=True, pairs=1), Claim("latin", n=params.N)]
 
 
 @register
@@ -388,6 +324,7 @@ class ZSobol(Baseline):
     """
 
     name = "zsobol"
+    strata = PAIRS
     code = 11
     progressive = True
     counts = "pow2"
@@ -397,9 +334,6 @@ class ZSobol(Baseline):
     kernel = "pyoa_sample_zsobol"
     description = ("pbrt-v4's Z-order Sobol (Ahmed-Wonka): N a power of two, blue-noise error across pixels; "
                    "needs resolution=(width, height)")
-
-    def params(self, spp, dims):
-        return Params(s=2, strength=2, block_dims=2, M=spp, dims=dims or 0)
 
     def with_resolution(self, params, resolution):
         if resolution is None:
@@ -418,15 +352,18 @@ class ZSobol(Baseline):
         width, height = params.resolution
         return width * height
 
+    def arguments(self, params):
+        return {"resolution": params.resolution}
+
     def shape_args(self, params):
         width, height = params.resolution
-        return (params.M.bit_length() - 1, _reference_zsobol.resolution_log2(width, height), width)
+        return (params.N.bit_length() - 1, _reference_zsobol.resolution_log2(width, height), width)
 
     def seed_args(self, pixel_seed, seed, pixel):
         return (pixel, seed)  # the Morton curve needs the pixel itself; the seed keys the pairs
 
     def claims(self, params, offset):
-        return [Claim("net", n=params.M), Claim("latin", n=params.M)]
+        return [Claim("net", n=params.N), Claim("latin", n=params.N)]
 
     def test_cases(self):
         # one pixel, a non-power-of-two image at an odd k, full HD, the largest image and count
@@ -452,6 +389,7 @@ class PMJ02(Baseline):
     """
 
     name = "pmj02"
+    strata = PAIRS
     code = 12
     progressive = True
     spp_invariant = True  # log2n only bounds i: the index scramble covers all 2**16
@@ -463,11 +401,8 @@ class PMJ02(Baseline):
     description = (f"progressive multi-jittered (0,2) (Christensen et al.): N a power of two up to "
                    f"2^{_reference_pmj02.POINTS_LOG2}, every power-of-two prefix a (0,2)-net")
 
-    def params(self, spp, dims):
-        return Params(s=2, strength=2, block_dims=2, M=spp, dims=dims or 0)
-
     def shape_args(self, params):
-        return (params.M.bit_length() - 1,)
+        return (params.N.bit_length() - 1,)
 
     def constants(self, params):
         return pmj02_tables.tables()
@@ -476,4 +411,4 @@ class PMJ02(Baseline):
         return self.name  # one table for every count
 
     def claims(self, params, offset):
-        return [Claim("net", n=params.M, prefixes=True), Claim("latin", n=params.M)]
+        return [Claim("net", n=params.N, prefixes=True), Claim("latin", n=params.N)]

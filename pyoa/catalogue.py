@@ -12,13 +12,13 @@ the test suites.
 from __future__ import annotations
 
 from . import baselines, constructions, progressive  # noqa: F401  (importing them registers their entries)
-from .catalogue_types import MAX_DIMS, REGISTRY, Construction, SppChoice, check_int
+from .catalogue_types import FAMILIES, MAX_DIMS, Construction, SppChoice, check_int
 
-#: Every sampler: the OA constructions, then the comparison samplers.
-SAMPLERS: dict[str, Construction] = {
-    **{n: c for n, c in REGISTRY.items() if c.family == "oa"},
-    **{n: c for n, c in REGISTRY.items() if c.family != "oa"},
-}
+#: The families of :attr:`Construction.family`, in the order the catalogue lists them.
+FAMILY_ORDER = ("oa", "baseline", "progressive")
+
+#: Every sampler: the OA constructions, then the comparison samplers, then faure.
+SAMPLERS: dict[str, Construction] = {n: c for group in FAMILY_ORDER for n, c in FAMILIES[group].items()}
 
 
 #: Names that users of pbrt-v4 and Mitsuba 3 type, each for the pyoa sampler that does the same job
@@ -41,8 +41,8 @@ def aliases_of(name: str) -> list[str]:
 
 def names(family: str | None = None) -> list[str]:
     """The sampler names, of one family (``"oa"``, ``"baseline"`` or
-    ``"progressive"``) or all."""
-    return [n for n, c in SAMPLERS.items() if family is None or c.family == family]
+    ``"progressive"``, :data:`FAMILY_ORDER`) or all."""
+    return list(SAMPLERS if family is None else FAMILIES.get(family, ()))
 
 
 #: The samplers of ``pyoa compare`` and ``pyoa study`` given no ``--samplers``: bose first (their ratios

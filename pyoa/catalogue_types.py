@@ -4,8 +4,9 @@ A sampler of pyoa is one *entry* of the catalogue (:mod:`pyoa.catalogue`):
 an instance of a :class:`Construction` subclass, registered once with
 :func:`register`. The entry holds what every backend, test and error message
 needs to know about the sampler before a single value is computed (its valid
-sample counts and the parameters they mean) and names its three
-implementations, which give the same bits:
+sample counts and the parameters they mean, of its family's type in
+:mod:`pyoa.params`) and names its three implementations, which give the same
+bits:
 
 ``reference``
     the pure-Python function of :mod:`pyoa.reference` (one value at a time);
@@ -24,9 +25,12 @@ backends, the name lists and the conformance and
 property suites (``tests/test_catalogue.py``) are built from the registry.
 
 This module imports only the seed hashes below it (:mod:`pyoa.reference`,
-:mod:`pyoa.hashes`); the entries
-(:mod:`pyoa.constructions`, :mod:`pyoa.baselines`) import it, and
-:mod:`pyoa.catalogue` imports them, so the dependencies run one way.
+:mod:`pyoa.hashes`); the entries (:mod:`pyoa.constructions`,
+:mod:`pyoa.baselines`, :mod:`pyoa.progressive`) import it and
+:mod:`pyoa.params`, and :mod:`pyoa.catalogue` imports them, so the
+dependencies run one way. Behaviour that depends on an entry's family is a
+method of that family's class (:class:`Construction`); :data:`FAMILIES`
+groups the entries for listing only.
 
 Limits
 ------
@@ -42,8 +46,9 @@ import numbers
 import os
 import operator
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import NamedTuple
+
+import numpy as np
 
 from .hashes import pixel_seed as _numpy_pixel_seed
 from .reference.hashes import pixel_seed as _reference_pixel_seed
@@ -124,32 +129,16 @@ class SppChoice(NamedTuple):
 
     def label(self) -> str:
         """Short text such as ``"121 (s=11)"``, ``"125 (s=5, t=3)"`` or ``"128 (2^7)"``."""
+        shape = self.shape()
+        return f"{self.spp} ({shape})" if shape else str(self.spp)
+
+    def shape(self) -> str:
+        """What :meth:`label` adds to the count: ``"s=11"``, ``"s=5, t=3"``, ``"2^7"`` or ``""``."""
         if self.detail or self.strength == 0:
-            return f"{self.spp} ({self.detail})" if self.detail else str(self.spp)
+            return self.detail
         if self.strength == 2:
-            return f"{self.spp} (s={self.s})"
-        return f"{self.spp} (s={self.s}, t={self.strength})"
-
-
-@dataclass(frozen=True)
-class Params:
-    """Resolved parameters of one sampler.
-
-    ``M = N / s`` is the number of fine sub-strata inside one coarse stratum.
-    ``dims`` is the sampler's number of dimensions (0 where unknown, as in
-    :func:`valid_spp`); only some comparison samplers depend on it. For the
-    comparison samplers (:mod:`pyoa.baselines`) ``s``, ``strength`` and ``M``
-    describe their grids as documented there.
-    """
-
-    s: int
-    strength: int
-    block_dims: int
-    M: int
-    dims: int = 0
-    #: the image (width, height) of a sampler whose values depend on where a
-    #: pixel lies in it (``zsobol``); None for the others
-    resolution: tuple[int, int] | None = None
+            return f"s={self.s}"
+        return f"s={self.s}, t={self.strength}"
 
 
 class _Counts(Sequence):
@@ -226,10 +215,31 @@ class Claim(NamedTuple):
     pairs: int = 0
 
 
+class Launch(NamedTuple):
+    """How the OpenCL backend computes a sampler value by value
+    (``kernels/generate.cl``): the kernel, its arguments between the user
+    seed and the sampler's constants, and the Galois field whose tables go
+    between them (None: the kernel takes no field)."""
+
+    kernel: str
+    args: tuple
+    field: int | None = None
+
+
 class Construction:
     """Base class of the catalogue's entries (see the module docstring).
 
-    Subclasses define :meth:`choices` (every valid sample count),
+    Each family has its own subclass, which the entries derive from:
+    :class:`pyoa.constructions._OA` (the orthogonal arrays, family
+    ``"oa"``), :class:`pyoa.baselines.Baseline` (the comparison samplers,
+    ``"baseline"``) and :class:`pyoa.progressive.Faure`
+    (``"progressive"``). A family's subclass answers, as methods, every
+    question whose answer depends on the family (the parameter type of
+    :mod:`pyoa.params` it resolves to, what a listing shows of it, its
+    implementations' arguments, its OpenCL launch), so that no caller tests
+    the family: :attr:`family` only groups the entries for listing.
+
+    Entries define :meth:`choices` (every valid sample count),
     :meth:`solve` and :meth:`invalid` (the parameters for a requested count,
     or why there are none) and their implementations: ``reference`` and
     ``numpy`` (functions, as ``staticmethod``) and ``kernel``: the name of
@@ -250,11 +260,21 @@ class Construction:
     reference = None
     numpy = None
     kernel: str = ""
-    #: "oa" for the orthogonal arrays, "baseline" for the comparison samplers
-    family = "oa"
-    #: whether the integer array is computed in a Galois field (the backends
-    #: then need pyoa.gf's tables for prime-power orders); see field_order
-    uses_field = False
+    #: the group the entry is listed in (:func:`pyoa.catalogue.names`):
+    #: "oa", "baseline" or "progressive"; set by each family's class
+    family: str
+    #: the module of :mod:`pyoa._drjit` that may define the entry's Dr.Jit
+    #: function (named :attr:`function`); named, not imported: Dr.Jit is optional
+    drjit_module: str
+    #: whether the Dr.Jit function takes ``located=(P, row)``, the block
+    #: seed and row of dimension j (docs/spec.md section 6), which a caller
+    #: drawing one dimension after another keeps per block (pyoa.mitsuba)
+    drjit_located = False
+    #: the offset styles the sampler takes (docs/spec.md section 4), and its default
+    offsets: tuple[str, ...] = ()
+    default_offset: str | None = None
+    #: whether the sampler takes a jitter amount
+    jittered = False
     #: whether a sampler needs the image resolution (``resolution=``): its
     #: values depend on where a pixel lies in the image
     needs_resolution = False
@@ -262,6 +282,9 @@ class Construction:
     #: stratification (its first n samples are as good as any n): a render
     #: may stop after any block of samples (``pyoa render --progressive``)
     progressive = False
+    #: why a prefix is not stratified as the whole is, where it is not
+    #: (the refusal of ``pyoa render --progressive``)
+    why_not_progressive = ""
     #: whether a pixel's i-th sample is the same for every ``spp``: a stopped
     #: progressive render may continue to a larger count (``--resume``)
     spp_invariant = False
@@ -276,15 +299,32 @@ class Construction:
     def __delattr__(self, key):
         raise AttributeError(f"cannot delete {key!r}: the catalogue's constructions are immutable")
 
-    def field_order(self, params: Params) -> int:
-        """Order of the field the array is computed in (0: none)."""
-        return params.s if self.uses_field else 0
+    def choice(self, params) -> SppChoice:
+        """What a listing shows of ``params`` (:func:`pyoa.valid_spp`, the
+        sampler's ``s``, ``strength`` and ``block_dims``)."""
+        raise NotImplementedError
 
-    def constants(self, params: Params):
+    def detail(self, params) -> str:
+        """What a sampler's repr shows of ``params`` after its options
+        (``"s=11, strength=2, block_dims=12"``, ``"grid 10x12"``), or ``""``."""
+        return ""
+
+    def spp_table(self, choices) -> list[str]:
+        """The lines ``pyoa spp`` prints of ``choices`` (:meth:`choices`): a
+        header, then a row per choice."""
+        raise NotImplementedError
+
+    def arguments(self, params) -> dict:
+        """The keyword arguments of :func:`pyoa.sampler`, besides ``spp`` and
+        ``dims``, that resolve to ``params`` again (a resolved strength, a
+        default base, the image): a copy of a sampler cannot resolve others."""
+        return {}
+
+    def constants(self, params):
         """Per-sampler constants the kernels read (empty: none)."""
         return []
 
-    def constants_key(self, params: Params):
+    def constants_key(self, params):
         """What :meth:`constants` depends on (a backend uploads them once per key)."""
         return (self.name, params)
 
@@ -293,8 +333,9 @@ class Construction:
         """The entry's name as an identifier (kernel names, defines)."""
         return self.name.replace("-", "_")
 
-    def shape_args(self, params: Params) -> tuple[int, ...]:
-        return (params.s, params.strength)
+    def shape_args(self, params) -> tuple[int, ...]:
+        """The integer arguments that fix the shape of the computation."""
+        raise NotImplementedError
 
     def seed_args(self, pixel_seed, seed, pixel) -> tuple:
         """The seed arguments of the implementations: by default the pixel's
@@ -303,10 +344,14 @@ class Construction:
         return (pixel_seed(seed, pixel),)
 
     def options(self, offset, jitter) -> tuple:
-        """The arguments after the seeds: offset and jitter for the OAs."""
-        return (offset, jitter)
+        """The arguments after the seeds (the offset style, the jitter amount, as the sampler takes them)."""
+        raise NotImplementedError
 
-    def evaluate(self, impl: str, i, j, params: Params, seed, pixel, offset, jitter):
+    def launch(self, params, offset, jitter) -> Launch:
+        """The OpenCL kernel that computes a value from scratch, and its arguments (:class:`Launch`)."""
+        raise NotImplementedError
+
+    def evaluate(self, impl: str, i, j, params, seed, pixel, offset, jitter):
         """Evaluate with implementation ``impl`` (``"reference"``: Python ints,
         one value; ``"numpy"``: broadcastable arrays)."""
         if impl not in ("reference", "numpy"):
@@ -316,7 +361,7 @@ class Construction:
         return f(i, j, *self.shape_args(params), *self.seed_args(pixel_seed, seed, pixel),
                  *self.options(offset, jitter))
 
-    def with_resolution(self, params: Params, resolution) -> Params:
+    def with_resolution(self, params, resolution):
         """``params`` for an image of ``resolution = (width, height)``: None for
         the samplers that do not use it (they refuse one), required by those
         that do (:attr:`needs_resolution`)."""
@@ -327,7 +372,7 @@ class Construction:
                              "pixel lies in the image")
         return params
 
-    def with_base(self, params: Params, base) -> Params:
+    def with_base(self, params, base):
         """``params`` in the digit base ``base``: None for the samplers without
         one (they refuse one), a prime for those with one (``faure``)."""
         if base is not None:
@@ -336,11 +381,11 @@ class Construction:
                              f"{'has' if len(having) == 1 else 'have'} a digit base")
         return params
 
-    def pixel_count(self, params: Params) -> int:
+    def pixel_count(self, params) -> int:
         """How many pixel indices are valid: ``2**32`` unless the sampler has an image."""
         return MAX_UINT32 + 1
 
-    def claims(self, params: Params, offset: str | None) -> list[Claim]:
+    def claims(self, params, offset: str | None) -> list[Claim]:
         """The stratification properties a sampler of these parameters
         guarantees for every pixel (checked by the property suite)."""
         return []
@@ -355,8 +400,9 @@ class Construction:
     def choices(self, dims: int | None = None, strength: int | None = None) -> list[SppChoice]:
         raise NotImplementedError
 
-    def solve(self, spp: int, dims: int | None, strength: int | None) -> Params | None:
-        """The parameters for ``spp`` samples, or None if it is not a valid count.
+    def solve(self, spp: int, dims: int | None, strength: int | None):
+        """The parameters for ``spp`` samples (of the family's type,
+        :mod:`pyoa.params`), or None if it is not a valid count.
 
         Raises ValueError only for an invalid ``strength`` argument."""
         raise NotImplementedError
@@ -365,7 +411,7 @@ class Construction:
         """Why ``spp`` is not a valid count (the start of the error message)."""
         raise NotImplementedError
 
-    def resolve(self, spp: int, dims: int | None, strength: int | None) -> Params:
+    def resolve(self, spp: int, dims: int | None, strength: int | None):
         """Like :meth:`solve`, but an invalid count raises a ValueError naming the
         nearest valid counts of this construction and the others that accept it."""
         prm = self.solve(spp, dims, strength)
@@ -381,10 +427,93 @@ class Construction:
         return nearest(self.choices(dims=dims, strength=strength), spp)
 
 
-#: Every registered entry by name, in registration order (the OA
-#: constructions, then the comparison samplers); :mod:`pyoa.catalogue`
-#: exposes it as ``SAMPLERS`` once both modules of entries are imported.
+class CountRule(Construction):
+    """Base of the entries whose valid counts are a rule of the count alone
+    (every count, the powers of two or the squares, up to :attr:`max_spp`),
+    which have no strength and no offset styles: the comparison samplers
+    (:mod:`pyoa.baselines`) and ``faure`` (:mod:`pyoa.progressive`).
+
+    Their implementations are called as ``function(i, j, *shape_args(params),
+    *seed_args(...)[, jitter])`` (a jitter amount only where :attr:`jittered`),
+    in the OpenCL program by one ``generate_{function}`` kernel each."""
+
+    #: largest number of dimensions
+    max_dims = MAX_DIMS
+    #: what a refusal of more dimensions than :attr:`max_dims` suggests
+    more_dims_hint = ""
+    #: sample counts: "any" (1 .. max_spp), "pow2" (powers of two) or "square"
+    counts = "any"
+    #: largest sample count
+    max_spp = MAX_SPP
+    why_not_progressive = "its grid is stratified only at the full count, not in its prefixes"
+
+    def params(self, spp: int, dims: int | None):
+        """The parameters of a valid ``spp`` (of the entry's type, :mod:`pyoa.params`)."""
+        raise NotImplementedError
+
+    def _check(self, dims, strength):
+        if strength is not None:
+            raise ValueError(f"{self.name} has no strength parameter (got strength={strength}); "
+                             "strength applies to the orthogonal-array samplers")
+        if dims is not None and dims > self.max_dims:
+            raise ValueError(f"{self.name} supports at most {self.max_dims} dimensions, got dims={dims}"
+                             f"{self.more_dims_hint}")
+
+    def _choice(self, spp: int, dims=None) -> SppChoice:
+        return self.choice(self.params(spp, dims))
+
+    def valid(self, spp: int) -> bool:
+        if not 1 <= spp <= self.max_spp:
+            return False
+        return self.counts == "any" or spp & (spp - 1) == 0
+
+    def choices(self, dims=None, strength=None):
+        self._check(dims, strength)
+        if self.counts == "any":  # every count 1 .. max_spp: listed lazily, not as 16.7 million tuples
+            return _Counts(1, self.max_spp, lambda n: self._choice(n, dims))
+        return [self._choice(1 << k, dims) for k in range(self.max_spp.bit_length())]
+
+    def nearest(self, spp, dims=None, strength=None):
+        self._check(dims, strength)
+        if self.counts == "any":  # every count in [1, max_spp]: the neighbours, not 16.7 million choices
+            near = min(max(int(spp), 0), self.max_spp + 1)
+            return [self._choice(n, dims) for n in (near - 1, near, near + 1) if 1 <= n <= self.max_spp]
+        return nearest(self.choices(dims), spp)
+
+    def solve(self, spp, dims, strength):
+        self._check(dims, strength)
+        return self.params(spp, dims) if self.valid(spp) else None
+
+    def invalid(self, spp, dims, strength):
+        if self.counts == "pow2":
+            return f"{spp} is not a power of two in [1, 2^{self.max_spp.bit_length() - 1}]"
+        return f"{spp} is not in [1, 2^24]"
+
+    def shape_args(self, params):
+        return ()
+
+    def options(self, offset, jitter):
+        # no offset styles; a jitter amount only where the sampler has one
+        return (jitter,) if self.jittered else ()
+
+    def launch(self, params, offset, jitter):
+        # the kernel's a, b, c: the shape arguments, zero-padded to three
+        a, b, c = (*self.shape_args(params), 0, 0, 0)[:3]
+        return Launch(f"generate_{self.function}", (np.uint32(a), np.uint32(b), np.uint32(c), np.float32(jitter)))
+
+    def test_cases(self):
+        # one sample, a few, the largest count (its last sample), many dimensions
+        few = 12 if self.counts == "any" else 16
+        return [dict(spp=1, dims=1), dict(spp=few, dims=5), dict(spp=self.max_spp, dims=3),
+                dict(spp=4, dims=min(self.max_dims, 600))]
+
+
+#: Every registered entry by name, in registration order; :mod:`pyoa.catalogue`
+#: exposes them as ``SAMPLERS`` (the OA constructions first) once every
+#: module of entries is imported.
 REGISTRY: dict[str, Construction] = {}
+#: The registered entries of each family (:attr:`Construction.family`), by name.
+FAMILIES: dict[str, dict[str, Construction]] = {}
 
 
 def register(cls: type[Construction]) -> type[Construction]:
@@ -404,14 +533,16 @@ def register(cls: type[Construction]) -> type[Construction]:
     if entry.code in taken:
         raise ValueError(f"{entry.name}: kernel code {entry.code} is already {taken[entry.code]}'s")
     REGISTRY[entry.name] = entry
+    FAMILIES.setdefault(entry.family, {})[entry.name] = entry
     return cls
 
 
 def _elsewhere(this: Construction, spp: int, dims: int | None) -> str:
-    """``"; 64 is valid for bush (s=4, t=3), cmjnd (s=8)"``, or ``""``."""
+    """``"; 64 is valid for bush (s=4, t=3), cmjnd (s=8)"``: the other entries of
+    ``this``'s family that accept ``spp``, or ``""``."""
     found = []
-    for c in REGISTRY.values():
-        if c is this or c.family != this.family:
+    for c in FAMILIES[this.family].values():
+        if c is this:
             continue
         try:
             prm = c.solve(spp, dims, None)
@@ -419,6 +550,6 @@ def _elsewhere(this: Construction, spp: int, dims: int | None) -> str:
             continue
         if prm is None:
             continue
-        label = SppChoice(spp, prm.s, prm.strength, prm.block_dims, getattr(c, "detail", lambda _: "")(prm)).label()
-        found.append(f"{c.name} ({label[len(str(spp)) + 2:-1]})" if label != str(spp) else c.name)
+        shape = c.choice(prm).shape()
+        found.append(f"{c.name} ({shape})" if shape else c.name)
     return f"; {spp} is valid for {', '.join(found)}" if found else ""

@@ -15,18 +15,23 @@ import itertools
 import math
 from functools import lru_cache
 
+import numpy as np
+
 from . import gf
 from ._numpy import oa as _numpy_oa
 from .catalogue_types import (
     MAX_SPP,
+    OFFSET_CODES,
+    OFFSETS,
     Claim,
     Construction,
-    Params,
+    Launch,
     SppChoice,
     _Counts,
     nearest,
     register,
 )
+from .params import OAParams
 from .reference import oa as _reference_oa
 
 
@@ -74,9 +79,22 @@ def _power_candidates(spp: int, strengths, valid, choice) -> list[SppChoice]:
 
 
 class _OA(Construction):
-    """Shared parts of the orthogonal arrays: their kernel arguments, the
-    cells the table paths gather with, and the properties they guarantee."""
+    """The orthogonal arrays' family: their parameters (:class:`pyoa.params.OAParams`),
+    kernel arguments and offset styles, the cells the table paths gather with,
+    and the properties they guarantee."""
 
+    family = "oa"
+    drjit_module = "oa"
+    drjit_located = True
+    offsets = OFFSETS
+    default_offset = "cmj"
+    jittered = True
+    why_not_progressive = ("an orthogonal array is stratified only as a whole (all N samples): its first samples "
+                           "are no smaller array (bose's first s samples share one stratum of dimension 0), so its "
+                           "intermediate images would be poor")
+    #: whether the array is computed in a Galois field (the backends then
+    #: need pyoa.gf's tables for prime-power orders); see field_order
+    uses_field = False
     #: whether the 'j' offset's cell key is Bose's partner cell
     #: ``u * s + A_ij + 1`` rather than ``i + 1`` (docs/spec.md section 4)
     partner_cell_key = False
@@ -85,27 +103,54 @@ class _OA(Construction):
     #: included) that every implementation and this catalogue read
     geometry = None
 
-    def params_for(self, s: int, t: int) -> Params:
+    def params_for(self, s: int, t: int) -> OAParams:
         """The resolved parameters of the array with ``s`` symbols and strength ``t``."""
         g = self.geometry(s, t)
-        return Params(s=s, strength=t, block_dims=g.B, M=g.M)
+        return OAParams(N=g.N, B=g.B, s=s, M=g.M, t=t)
 
     def choice_for(self, s: int, t: int) -> SppChoice:
         """The sample count of the array with ``s`` symbols and strength ``t``, as a listed choice."""
-        g = self.geometry(s, t)
-        return SppChoice(g.N, s, t, g.B)
+        return self.choice(self.params_for(s, t))
 
-    def cells(self, i, col, params: Params):
-        """``(A_ij, u)`` of samples ``i`` in columns ``col < block_dims``
+    def choice(self, params):
+        return SppChoice(params.N, params.s, params.t, params.B)
+
+    def detail(self, params):
+        return f"s={params.s}, strength={params.t}, block_dims={params.B}"
+
+    def arguments(self, params):
+        return {"strength": params.t}
+
+    def spp_table(self, choices):
+        return [f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}",
+                *(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}" for c in choices)]
+
+    def field_order(self, params: OAParams) -> int:
+        """Order of the field the array is computed in (0: none)."""
+        return params.s if self.uses_field else 0
+
+    def shape_args(self, params):
+        return (params.s, params.t)
+
+    def options(self, offset, jitter):
+        return (offset, jitter)
+
+    def launch(self, params, offset, jitter):
+        # kernels/generate.cl's generate: every OA through one kernel, dispatched by the code
+        args = (self.code, params.s, params.t, params.B, params.N, params.M, OFFSET_CODES[offset])
+        return Launch("generate", (*map(np.uint32, args), np.float32(jitter)), self.field_order(params))
+
+    def cells(self, i, col, params: OAParams):
+        """``(A_ij, u)`` of samples ``i`` in columns ``col < B``
         (NumPy arrays): the cell and its sub-stratum index, which do not depend
         on the pixel (the table paths of both backends compute them once per
         rectangle, :mod:`pyoa.host_tables`)."""
         raise NotImplementedError
 
     def claims(self, params, offset):
-        out = [Claim("oa", s=params.s, strength=params.strength, block_dims=params.block_dims)]
+        out = [Claim("oa", s=params.s, strength=params.t, block_dims=params.B)]
         if offset in ("cmj", "mj"):  # 1D Latin hypercubes at N (docs/spec.md section 4)
-            out.append(Claim("latin", n=params.s * params.M))
+            out.append(Claim("latin", n=params.N))
         return out
 
 
@@ -177,7 +222,7 @@ class Bush(_OA):
         return list(range(2, max(2, min(dims or self.max_strength, self.max_strength)) + 1))
 
     def cells(self, i, col, params):
-        return _numpy_oa.bush_cell(i, col, params.s, params.strength)
+        return _numpy_oa.bush_cell(i, col, params.s, params.t)
 
     def test_cases(self):
         # s = t = 2, t = 3 over GF(4) (two blocks), s = 5 t = 4, the largest: s = t = 8

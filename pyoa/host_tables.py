@@ -42,13 +42,13 @@ def array_cells(req) -> tuple[np.ndarray, np.ndarray]:
     ``(n_dims, N)``, laid out ``[d][row]``. The table paths gather from them
     at a later block's own rows (docs/spec.md section 6). ``u`` is 0 for the
     ``centered`` offset."""
-    return _cells_at(req, np.arange(req.params.s * req.params.M, dtype=U32))
+    return _cells_at(req, np.arange(req.params.N, dtype=U32))
 
 
 def _cells_at(req, rows) -> tuple[np.ndarray, np.ndarray]:
     """``(A_ij, u)`` of ``rows`` in each requested dimension's column, shape
     ``(n_dims, len(rows))``, C-contiguous uint32; ``u`` is 0 for ``centered``."""
-    col = (req.dims % U32(req.params.block_dims))[:, None]
+    col = (req.dims % U32(req.params.B))[:, None]
     aij, u = req.construction.cells(np.asarray(rows, dtype=U32)[None, :], col, req.params)
     shape = (req.n_dims, len(rows))
     aij = np.ascontiguousarray(np.broadcast_to(aij, shape), dtype=U32)
@@ -70,11 +70,11 @@ def block_seeds(req, pix0: int, pix1: int) -> tuple[np.ndarray, np.ndarray, np.n
     blocks and many dimensions per block."""
     prm = req.params
     p = pixel_seed(req.seed, req.pixels[pix0:pix1])
-    blocks, which = np.unique(req.dims // U32(prm.block_dims), return_inverse=True)
+    blocks, which = np.unique(req.dims // U32(prm.B), return_inverse=True)
     seeds = np.empty((len(p), len(blocks)), dtype=U32)  # (pixels, distinct blocks); none for no dims
     for k, b in enumerate(blocks):
         seeds[:, k] = block_seed(p, b)
-    orders = block_order_seed(seeds, blocks[None, :], prm.s * prm.M)
+    orders = block_order_seed(seeds, blocks[None, :], prm.N)
     return blocks, which.ravel(), seeds, orders
 
 
@@ -86,7 +86,7 @@ def column_keys(req, pix0: int, pix1: int) -> np.ndarray:
     if pix1 == pix0 or req.n_dims == 0:
         return np.empty((pix1 - pix0, req.n_dims), dtype=U32)
     _, which, seeds, _ = block_seeds(req, pix0, pix1)
-    return seeds[:, which] * (req.dims % U32(req.params.block_dims) + U32(1))
+    return seeds[:, which] * (req.dims % U32(req.params.B) + U32(1))
 
 
 def table_keys(req, pix0: int, pix1: int) -> np.ndarray:

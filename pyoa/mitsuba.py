@@ -329,7 +329,7 @@ def _make_class(base: type) -> type:
             j = mi.UInt32(self.m_dimension)
             f = _drjit.implementation(entry.name)
             args = (i, j, *entry.shape_args(smp.params), self._pixel_seed, *entry.options(smp.offset, smp.jitter))
-            x = f(*args, located=self._located(i, j)) if entry.family == "oa" else f(*args)
+            x = f(*args, located=self._located(i, j)) if entry.drjit_located else f(*args)
             self.m_dimension += 1
             return mi.Float(x)
 
@@ -341,7 +341,7 @@ def _make_class(base: type) -> type:
             wavefront), so the loop below runs for all lanes or none: inside Mitsuba's symbolic loops
             Dr.Jit skips its body on every draw that stays in the block."""
             prm = self._pyoa.params
-            N, block = prm.s * prm.M, j // prm.block_dims
+            N, block = prm.N, j // prm.B
             p = self._pixel_seed
 
             def locate(P, row, todo):
@@ -361,8 +361,7 @@ def _make_class(base: type) -> type:
 
         def to_string(self) -> str:
             smp = self._pyoa
-            c, prm = smp._construction, smp.params
-            detail = c.detail(prm) if hasattr(c, "detail") else f"s={prm.s}, t={prm.strength}"
+            detail = smp._construction.choice(smp.params).shape()
             opts = ", ".join(f"{k}={v!r}" for k, v in self._opts.items() if k not in ("sampler", "sample_count"))
             return (f"PyoaSampler[{smp.name}, sample_count={self._spp}{', ' + opts if opts else ''}"
                     f"{' (' + detail + ')' if detail else ''}, samples per wavefront {self._spw}]")

@@ -23,13 +23,12 @@ References
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import numbers
 
 from ._numpy import faure as _numpy_faure
-from .baselines import Baseline
-from .catalogue_types import MAX_SPP, Claim, Params, register
+from .catalogue_types import MAX_SPP, Claim, CountRule, SppChoice, register
+from .params import FaureParams
 from .reference import faure as _reference_faure
 
 #: Largest base (the largest prime ``b`` with ``b**2 <= 2**24``).
@@ -70,7 +69,7 @@ def _levels(b: int, spp: int) -> int:
 
 
 @register
-class Faure(Baseline):
+class Faure(CountRule):
     """``faure``: Owen-scrambled Faure (0, s)-sequence, progressive orthogonal arrays.
 
     Any ``spp`` in ``[1, 2**24]``. ``base=b``, a prime in ``[2, 4093]``:
@@ -105,6 +104,7 @@ class Faure(Baseline):
     name = "faure"
     code = 13
     family = "progressive"
+    drjit_module = "faure"
     has_base = True
     progressive = True
     spp_invariant = True
@@ -116,10 +116,19 @@ class Faure(Baseline):
 
     def params(self, spp, dims):
         b = default_base(spp, dims)
-        return Params(s=b, strength=_levels(b, spp), block_dims=b, M=spp, dims=dims or 0)
+        return FaureParams(N=spp, b=b, m=_levels(b, spp))
 
-    def detail(self, prm):
-        return f"b={prm.s}"
+    def choice(self, params):
+        # s: the base's b strata per axis of a full net; strength: its full nets, b^m <= N
+        return SppChoice(params.N, params.b, params.m, params.b, f"b={params.b}")
+
+    def arguments(self, params):
+        return {"base": params.b}
+
+    def spp_table(self, choices):
+        # any count; the base of each (given or default) and its full nets b^m (aligned blocks of b^m samples are nets)
+        return [f"{'spp':>9s} {'base':>5s} {'full nets':>10s} {'dims/block':>10s}",
+                *(f"{c.spp:9d} {c.s:5d} {f'{c.s}^{c.strength}':>10s} {c.block_dims:10d}" for c in choices)]
 
     def with_base(self, params, base):
         if base is None:
@@ -131,14 +140,13 @@ class Faure(Baseline):
             near = sorted(BASES, key=lambda b: (abs(b - base), b))[:2]
             raise ValueError(f"faure: base must be a prime in [2, {MAX_BASE}], got {base}; nearest: "
                              f"{', '.join(map(str, sorted(near)))}")
-        return dataclasses.replace(params, s=base, block_dims=base, strength=_levels(base, params.M))
+        return FaureParams(N=params.N, b=base, m=_levels(base, params.N))
 
     def shape_args(self, params):
-        return (params.s, _reference_faure.index_digits(params.s, params.M))
+        return (params.b, _reference_faure.index_digits(params.b, params.N))
 
     def claims(self, params, offset):
-        return [Claim("faure", n=params.M, s=params.s, strength=min(3, max(params.strength, 1)),
-                      block_dims=params.s)]
+        return [Claim("faure", n=params.N, s=params.b, strength=min(3, max(params.m, 1)), block_dims=params.b)]
 
     def test_cases(self):
         # one sample; a prime count over two blocks; b^2 at base 7; the largest

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .catalogue_types import Construction, Params
+from .catalogue_types import Construction
+from .params import FaureParams, OAParams, PointSetParams, SequenceParams
 
 #: Most cells (entries per array, each of 4 bytes, twice) the OpenCL table
 #: path uploads for dimensions past the first block (:attr:`Request.array_cells_fit`).
@@ -23,8 +24,13 @@ MAX_ARRAY_CELLS = 1 << 22
 
 @dataclass(frozen=True)
 class Request:
+    """One bulk request. The table paths' properties (:attr:`table_entries`
+    and the others that read ``s``, ``M``, ``N`` or ``B``) are asked of the
+    orthogonal arrays only: :meth:`tables_pay_off` is False without an
+    offset style."""
+
     construction: Construction
-    params: Params
+    params: OAParams | PointSetParams | SequenceParams | FaureParams
     seed: int
     offset: str
     jitter: float
@@ -76,7 +82,7 @@ class Request:
         """Whether a dimension lies past the first block (docs/spec.md section
         6): such a dimension reads its copy at its own rows, which depend on
         the pixel, so the table paths gather its cells at those rows."""
-        return self.n_dims > 0 and int(self.dims.max()) >= self.params.block_dims
+        return self.n_dims > 0 and int(self.dims.max()) >= self.params.B
 
     @property
     def array_cells_fit(self) -> bool:
@@ -84,7 +90,7 @@ class Request:
         the array in each dimension's column (:func:`pyoa.host_tables.array_cells`),
         which it needs for dimensions past the first block: at most
         :data:`MAX_ARRAY_CELLS` entries. Larger requests take the direct path."""
-        return not self.past_block0 or self.n_dims * self.params.s * self.params.M <= MAX_ARRAY_CELLS
+        return not self.past_block0 or self.n_dims * self.params.N <= MAX_ARRAY_CELLS
 
     @property
     def table_stride(self) -> int:

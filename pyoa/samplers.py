@@ -26,7 +26,7 @@ import numpy as np
 
 from . import catalogue
 from .backends import choose
-from .catalogue_types import MAX_DIMS, MAX_SPP, MAX_UINT32, OFFSETS, check_int
+from .catalogue_types import MAX_DIMS, MAX_SPP, MAX_UINT32, check_int
 from .request import Request
 from .units import format_bytes
 
@@ -374,12 +374,15 @@ class Sampler:
         params = construction.with_base(params, base)
         max_bytes = default_max_bytes() if max_bytes is None else parse_bytes(max_bytes, "max_bytes")
         impl = choose(backend, device)
+        shown = construction.choice(params)
+        # the keywords that give these parameters again: a resolved strength, base or image
+        resolved = construction.arguments(params)
         # Every attribute is set here and never again (see __setattr__).
         fields = dict(
             _construction=construction, name=construction.name, spp=spp, dims=dims, seed=seed, offset=offset,
-            jitter=jitter, params=params, s=params.s, strength=params.strength, block_dims=params.block_dims,
-            resolution=params.resolution, n_pixels=construction.pixel_count(params),
-            base=params.s if construction.has_base else None,
+            jitter=jitter, params=params, s=shown.s, strength=shown.strength, block_dims=shown.block_dims,
+            resolution=resolved.get("resolution"), n_pixels=construction.pixel_count(params),
+            base=resolved.get("base"), _resolved=resolved,
             max_bytes=max_bytes, _backend=impl, _device_selector=device, backend=impl.name,
             device=impl.describe(),
         )
@@ -398,10 +401,8 @@ class Sampler:
         """The keyword arguments of :func:`sampler` that make this sampler again."""
         return dict(
             spp=self.spp, dims=self.dims, seed=self.seed, offset=self.offset, jitter=self.jitter,
-            # the resolved strength, so the copy cannot resolve another one; the
-            # comparison samplers take none
-            strength=self.strength if self._construction.family == "oa" else None, resolution=self.resolution,
-            base=self.base,
+            # the resolved strength, base and image, so the copy cannot resolve others
+            **{"strength": None, "resolution": None, "base": None, **self._resolved},
             backend=self.backend, device=self._device_selector, max_bytes=self.max_bytes,
         )
 
@@ -413,20 +414,14 @@ class Sampler:
         return (_rebuild, (self.name, self._arguments()))
 
     def __repr__(self) -> str:
-        if self._construction.family != "oa":
-            c = self._construction
-            grid = c.detail(self.params)
-            return (
-                f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}"
-                f"{f', jitter={self.jitter:g}' if c.jittered else ''}"
-                f"{f', resolution={self.resolution}' if self.resolution else ''}"
-                f"{f', base={self.base}' if self.base else ''}{f'; grid {grid}' if grid and not self.base else ''}; "
-                f"backend={self.backend!r} on {self.device})"
-            )
+        detail = self._construction.detail(self.params)
         return (
-            f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}, "
-            f"offset={self.offset!r}, jitter={self.jitter:g}; s={self.s}, strength={self.strength}, "
-            f"block_dims={self.block_dims}; backend={self.backend!r} on {self.device})"
+            f"Sampler({self.name!r}, spp={self.spp}, dims={self.dims}, seed={self.seed}"
+            f"{f', offset={self.offset!r}' if self.offset is not None else ''}"
+            f"{f', jitter={self.jitter:g}' if self._construction.jittered else ''}"
+            f"{f', resolution={self.resolution}' if self.resolution else ''}"
+            f"{f', base={self.base}' if self.base else ''}{f'; {detail}' if detail else ''}; "
+            f"backend={self.backend!r} on {self.device})"
         )
 
     def _request(self, pixels, samples, dims) -> Request:
@@ -809,15 +804,16 @@ def _check_chunk_count(count: int, given, shape: tuple[int, int, int], max_bytes
 
 
 def _offset(construction, offset):
-    """The checked offset style: ``"cmj"`` by default for the OA samplers, None for the others."""
-    is_oa = construction.family == "oa"
+    """The checked offset style: the sampler's default (``"cmj"`` for the OA
+    samplers, None for the others) when not given."""
     if offset is None:
-        return "cmj" if is_oa else None
-    if not is_oa:
+        return construction.default_offset
+    if not construction.offsets:
         raise ValueError(f"offset applies to the orthogonal-array samplers only; {construction.name} has none "
                          f"(got offset={offset!r})")
-    if not isinstance(offset, str) or offset not in OFFSETS:
-        raise ValueError(f"unknown offset {offset!r}; valid: {', '.join(OFFSETS)} (default 'cmj')")
+    if not isinstance(offset, str) or offset not in construction.offsets:
+        raise ValueError(f"unknown offset {offset!r}; valid: {', '.join(construction.offsets)} "
+                         f"(default {construction.default_offset!r})")
     return offset
 
 
@@ -827,7 +823,7 @@ def _jitter(construction, jitter) -> float:
         raise TypeError(f"jitter must be a real number in [0, 1], got {type(jitter).__name__}")
     if not 0.0 <= float(jitter) <= 1.0:  # NaN fails too
         raise ValueError(f"jitter must be in [0, 1] (1 = full jitter, 0 = cell centres), got {jitter}")
-    if not (construction.family == "oa" or construction.jittered) and float(jitter) != 1.0:
+    if not construction.jittered and float(jitter) != 1.0:
         raise ValueError(f"{construction.name} has no jitter amount (got jitter={jitter}); it applies to the "
                          "orthogonal-array samplers, jittered2d and cmj2d")
     return float(np.float32(jitter))

@@ -386,7 +386,7 @@ def test_cmj2d_sampler_pixels(backend, N, dims):
     for seed in (0, 5):
         smp = pyoa.sampler("cmj2d", spp=N, dims=dims, seed=seed, backend=backend)
         m, n = most_square(N)
-        assert (smp.s, smp.params.M) == (m, n)
+        assert (smp.s, smp.params.a, smp.params.c) == (m, m, n)
         check_cmj2d(smp.generate(pixels=PIXELS), N, dims, f"sampler N={N} seed={seed}")
 
 

@@ -318,9 +318,9 @@ def test_largest_spp(backend, name, spp, dims):
 def test_catalogue_grids():
     """The grids the edge cases rely on (a prime gives 1 x N; Halton's first and last bases)."""
     c = pyoa.catalogue.SAMPLERS["cmj2d"]
-    assert (c.params(BIG_PRIME, 3).s, c.params(BIG_PRIME, 3).M) == (1, BIG_PRIME)
-    assert (c.params(TWIN, 3).s, c.params(TWIN, 3).M) == (4093, 4099)
-    assert (c.params(MAX_SPP, 3).s, c.params(MAX_SPP, 3).M) == (4096, 4096)
+    assert (c.params(BIG_PRIME, 3).a, c.params(BIG_PRIME, 3).c) == (1, BIG_PRIME)
+    assert (c.params(TWIN, 3).a, c.params(TWIN, 3).c) == (4093, 4099)
+    assert (c.params(MAX_SPP, 3).a, c.params(MAX_SPP, 3).c) == (4096, 4096)
     assert is_prime(BIG_PRIME) and is_prime(4093) and is_prime(4099)
     primes = sequences.primes()
     assert len(primes) == HALTON_DIMS and list(primes[:2]) == [2, 3] and list(primes[-2:]) == [65519, 65521]

@@ -2,7 +2,7 @@
 
 The header's functions, built into a shared library as C99 and as C++14
 (warnings as errors), must accept exactly the requests :class:`pyoa.Sampler`
-accepts, resolve them to the same parameters (``Params``, ``shape_args``)
+accepts, resolve them to the same parameters (:mod:`pyoa.params`, ``shape_args``)
 and refuse the others with the same error kind and the same message (the
 nearest valid counts, the samplers that accept the count). The Python side
 is the oracle throughout: :func:`expect` runs the steps of
@@ -33,6 +33,7 @@ import pyoa
 from pyoa import catalogue
 from pyoa.samplers import _offset
 from pyoa.catalogue_types import MAX_DIMS, MAX_SPP, REGISTRY, _labels, check_int
+from pyoa.params import OAParams, PointSetParams
 from pyoa.progressive import BASES
 
 from .test_c_headers import INCLUDE, WARN, compile_, need
@@ -89,11 +90,27 @@ def quick_choices():
             cls.choices = own
 
 
-def params_row(construction, spp, prm) -> tuple:
-    """The C shim's row for Python's Params: pyoa_params' fields, then the shape arguments."""
-    width, height = prm.resolution or (0, 0)
+def flat_params(construction, prm, dims) -> tuple:
+    """``(s, strength, block_dims, M, dims)`` of C's pyoa_params for Python's
+    parameters (pyoa.params: one type per family), which C holds in one flat
+    struct: the listing's s, strength and block_dims (``construction.choice``);
+    M an OA's sub-strata, cmj2d's second side, jittered2d's 1 and every other
+    sampler's count; dims 0 for an OA (none depends on it)."""
+    shown = construction.choice(prm)
+    if isinstance(prm, OAParams):
+        M, dims = prm.M, None
+    elif isinstance(prm, PointSetParams):
+        M = 1 if construction.name == "jittered2d" else prm.c
+    else:
+        M = prm.N
+    return (shown.s, shown.strength, shown.block_dims, M, dims or 0)
+
+
+def params_row(construction, spp, dims, prm) -> tuple:
+    """The C shim's row for Python's parameters: pyoa_params' fields, then the shape arguments."""
+    width, height = construction.arguments(prm).get("resolution") or (0, 0)
     shape = (*construction.shape_args(prm), 0, 0, 0)[:3]
-    return (construction.code, spp, prm.s, prm.strength, prm.block_dims, prm.M, prm.dims, width, height, *shape)
+    return (construction.code, spp, *flat_params(construction, prm, dims), width, height, *shape)
 
 
 @functools.lru_cache(maxsize=None)
@@ -144,7 +161,7 @@ def expect(name, spp, strength=None, dims=None, base=None, resolution=None, offs
         prm = construction.with_base(prm, base)
     except ValueError as exc:
         return BASE, str(exc)
-    return OK, params_row(construction, spp, prm)
+    return OK, params_row(construction, spp, dims, prm)
 
 
 def c_solve(lib, cases):
@@ -345,7 +362,9 @@ def test_resolve_matches_the_sampler(lib, cases):
         assert want[0] == OK and rc == OK, (typed, spp, strength, dims, base, resolution, offset, buf.value)
         row = tuple(params)
         assert row == want[1]
-        assert row[:7] == (catalogue.get(typed).code, smp.spp, smp.s, smp.strength, smp.block_dims, smp.params.M, smp.params.dims)
+        entry = catalogue.get(typed)
+        assert row[:7] == (entry.code, smp.spp, smp.s, smp.strength, smp.block_dims,
+                           *flat_params(entry, smp.params, smp.dims)[3:])
         assert (row[7], row[8]) == (smp.resolution or (0, 0))
         assert smp.base in (None, row[2])
         want_offset = 4 if smp.offset is None else ("centered", "j", "mj", "cmj").index(smp.offset)

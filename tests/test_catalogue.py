@@ -30,7 +30,9 @@ from hypothesis import strategies as st
 
 import pyoa
 from pyoa import catalogue
-from pyoa.catalogue_types import OFFSETS, Claim
+from pyoa.baselines import Baseline
+from pyoa.catalogue_types import REGISTRY, Claim
+from pyoa.params import FaureParams, OAParams, PointSetParams, SequenceParams
 from tests.helpers import U32_MAX, assert_same_bits, net_failures, reference_block
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -54,9 +56,9 @@ def variants(name: str):
     of the OAs (at a jitter with many bits, and 'cmj' at 1), a jitter for the
     jittered comparison samplers."""
     entry = catalogue.get(name)
-    if entry.family == "oa":
-        return [("cmj", 1.0)] + [(o, JITTER) for o in OFFSETS]
-    return [(None, 1.0)] + ([(None, JITTER)] if getattr(entry, "jittered", False) else [])
+    if entry.offsets:
+        return [(entry.default_offset, 1.0)] + [(o, JITTER) for o in entry.offsets]
+    return [(None, 1.0)] + ([(None, JITTER)] if entry.jittered else [])
 
 
 def make(name, kw, backend, seed=0, offset=None, jitter=1.0):
@@ -79,6 +81,44 @@ def test_every_entry_is_complete_and_its_cases_resolve():
         for kw in c.test_cases():
             smp = pyoa.sampler(c.name, backend="numpy", **kw)
             assert smp.spp == kw["spp"] and smp.dims == kw["dims"]
+
+
+#: The parameter type each family resolves to (pyoa.params), per entry class.
+PARAMETER_TYPES = {"bose": OAParams, "bush": OAParams, "cmjnd": OAParams, "addelman-kempthorne": OAParams,
+                   "bose-bush": OAParams, "jittered2d": PointSetParams, "cmj2d": PointSetParams,
+                   "faure": FaureParams}
+
+
+@pytest.mark.parametrize("name, kw", CASES, ids=map(case_id, CASES))
+def test_parameters_are_of_the_family_type_and_give_the_sampler_again(name, kw):
+    """Every test case resolves to its family's parameter type (any other
+    comparison sampler: a sequence), whose count is the sampler's; the
+    listing's s, strength and block_dims are the sampler's; and the keywords
+    ``arguments`` names (a resolved strength, base or image) give the same
+    parameters at any dims (a copy cannot resolve others)."""
+    entry = catalogue.get(name)
+    smp = pyoa.sampler(name, backend="numpy", **kw)
+    prm = smp.params
+    assert type(prm) is PARAMETER_TYPES.get(name, SequenceParams) and prm.N == smp.spp
+    shown = entry.choice(prm)
+    assert (shown.spp, shown.s, shown.strength, shown.block_dims) == (smp.spp, smp.s, smp.strength, smp.block_dims)
+    again = {k: v for k, v in kw.items() if k not in ("strength", "base", "resolution")}
+    assert pyoa.sampler(name, backend="numpy", **{**again, **entry.arguments(prm)}).params == prm
+    assert entry.choice(pyoa.sampler(name, backend="numpy", **{**again, "dims": 1, **entry.arguments(prm)}).params) \
+        == shown
+
+
+def test_family_is_read_only_to_list_samplers():
+    """No module of pyoa branches on an entry's family (its family's class
+    answers instead), and faure is no comparison sampler: the catalogue
+    lists every registered entry, grouped by family."""
+    compared = re.compile(r"family\s*(==|!=)|family\s+(not\s+)?in\b")
+    found = [f"{p.relative_to(ROOT)}:{k}" for p in sorted((ROOT / "pyoa").rglob("*.py"))
+             for k, line in enumerate(p.read_text().splitlines(), 1) if compared.search(line)]
+    assert not found, f"family compared in {found}"
+    assert not isinstance(catalogue.get("faure"), Baseline)
+    assert list(catalogue.SAMPLERS) == [n for f in catalogue.FAMILY_ORDER for n in catalogue.names(f)]
+    assert set(catalogue.SAMPLERS) == set(REGISTRY)
 
 
 def test_register_refuses_a_taken_name_or_code():

@@ -128,7 +128,7 @@ def test_a_refused_spp_leaves_the_sampler_as_it_was(fresh, key, refused, match):
     # have (bose: the render never ended) or another base (faure: base 2 after a refused spp=4)
     assert (smp.sample_count(), smp.pyoa_sampler.spp, repr(smp)) == (spp, spp, description)
     if name == "faure":
-        assert smp.pyoa_sampler.params.s == 5  # faure's base (the largest prime b with b^2 <= 25)
+        assert smp.pyoa_sampler.params.b == 5  # faure's base (the largest prime b with b^2 <= 25)
     assert (bits(mi.render(sc, seed=5)) == image).all()
 
 

@@ -13,17 +13,18 @@ import drjit as dr
 from .. import catalogue
 from . import baselines, faure, hashes, oa
 
-#: Family -> the module of its Dr.Jit implementations: an entry is supported
-#: when that module defines a function named as the entry (``entry.function``).
-#: Every orthogonal array, faure and random; the other comparison samplers read
-#: tables (Sobol' matrices, PMJ02 points) and are left to Mitsuba's own samplers.
-MODULES = {"oa": oa, "progressive": faure, "baseline": baselines}
+#: The modules of the Dr.Jit implementations, by the name an entry gives
+#: (``entry.drjit_module``): an entry is supported when its module defines a
+#: function named as the entry (``entry.function``). Every orthogonal array,
+#: faure and random; the other comparison samplers read tables (Sobol'
+#: matrices, PMJ02 points) and are left to Mitsuba's own samplers.
+MODULES = {"oa": oa, "faure": faure, "baselines": baselines}
 
 #: Entry name -> its Dr.Jit implementation, from the catalogue.
 IMPLEMENTATIONS = {
     entry.name: f
-    for entry in map(catalogue.get, catalogue.names())
-    if callable(f := getattr(MODULES.get(entry.family), entry.function, None))
+    for entry in catalogue.SAMPLERS.values()
+    if callable(f := getattr(MODULES[entry.drjit_module], entry.function, None))
 }
 
 #: The supported names, in the catalogue's order.

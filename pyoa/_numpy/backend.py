@@ -82,9 +82,9 @@ class NumpyBackend:
         evaluates no row it does not need.
         """
         prm = req.params
-        N = prm.s * prm.M
+        N = prm.N
         blocks, which, seeds, orders = host_tables.block_seeds(req, rect.pix0, rect.pix1)
-        col = req.dims % U32(prm.block_dims)
+        col = req.dims % U32(prm.B)
         tables = NumpyBackend._tables(req, seeds[:, which] * (col + U32(1)))  # from the column keys
         i = req.samples[rect.k0 : rect.k1]
         first = int(blocks.size > 0 and blocks[0] == 0)  # the index of the first later block

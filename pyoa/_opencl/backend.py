@@ -6,7 +6,7 @@ import threading
 
 import numpy as np
 
-from .. import catalogue_types, gf
+from .. import gf
 from ..request import Rect, Request
 from . import vector
 from .choice import open_device
@@ -194,41 +194,29 @@ class OpenCLBackend:
             else:
                 buf = self._scratch("out", n_values * 4)
             dims = cl.Buffer(self.context, ro, hostbuf=req.dims)
-            if req.construction.family != "oa":
-                a, b, c = (*req.construction.shape_args(prm), 0, 0, 0)[:3]
-                kernel = f"generate_{req.construction.function}"
-                extra = (np.uint32(req.seed), np.uint32(a), np.uint32(b), np.uint32(c), np.float32(req.jitter),
-                         self._constants(req))
-            else:
-                kernel = "generate"
-                extra = (np.uint32(req.seed), np.uint32(req.construction.code),
-                         np.uint32(prm.s), np.uint32(prm.strength),
-                         np.uint32(prm.block_dims), np.uint32(prm.s * prm.M), np.uint32(prm.M),
-                         np.uint32(catalogue_types.OFFSET_CODES[req.offset]), np.float32(req.jitter),
-                         *self._field(req.construction.field_order(prm)), self._constants(req))
+            # the kernel that computes a value from scratch: the OAs' generate or a comparison sampler's own
+            launch = req.construction.launch(prm, req.offset, req.jitter)
+            field = () if launch.field is None else self._field(launch.field)
+            extra = (np.uint32(req.seed), *launch.args, *field, self._constants(req))
             use_vector = self.path == "vector"
             for rect in req.rectangles(row0, row1):
                 # each rectangle's values are a contiguous part of the chunk
                 at = np.uint32((rect.row0 - row0) * req.n_dims)
-                if req.construction.family != "oa":
-                    bshp = vector.baseline_shape(req, rect) if use_vector else None
-                    if bshp is not None and self._vector_pays(bshp, rect, req.n_dims):
-                        self._launch_vector_baseline(req, rect, bshp, buf, at, dims)
-                        continue
-                else:
-                    shp = vector.shape(req, rect) if use_vector else None
-                    if shp is not None and not self.path_forced and not shp.tabled and req.tables_pay_off(rect):
-                        shp = None  # a walked permutation: the table path is faster ('cmj', 'centered')
-                    if shp is not None and self._vector_pays(shp, rect, req.n_dims):
-                        self._launch_vector(req, rect, shp, buf, at, dims)
-                        continue
-                    if self.path != "direct" and req.tables_pay_off(rect) and req.array_cells_fit:
-                        self._launch_tabled(req, rect, buf, at)
-                        continue
+                shp = vector.shape(req, rect) if use_vector else None
+                if shp is not None and not self.path_forced and req.tables_pay_off(rect) and not shp.tabled:
+                    shp = None  # a walked permutation: the table path is faster ('cmj', 'centered')
+                if shp is not None and self._vector_pays(shp, rect, req.n_dims):
+                    launch_vector = (self._launch_vector_baseline if isinstance(shp, vector.BaselineShape)
+                                     else self._launch_vector)
+                    launch_vector(req, rect, shp, buf, at, dims)
+                    continue
+                if self.path != "direct" and req.tables_pay_off(rect) and req.array_cells_fit:
+                    self._launch_tabled(req, rect, buf, at)
+                    continue
                 # only the rectangle's pixels and samples travel to the device
                 pixels = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.pixels[rect.pix0 : rect.pix1]))
                 samples = cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(req.samples[rect.k0 : rect.k1]))
-                self._launch_2d(kernel, rect.n_k, rect.n_pixels * req.n_dims,
+                self._launch_2d(launch.kernel, rect.n_k, rect.n_pixels * req.n_dims,
                                 buf, at, pixels, samples, dims, np.uint32(rect.n_k), np.uint32(req.n_dims), *extra)
             if self.zero_copy:
                 # mapping makes the kernels' writes visible in `out` (where the
@@ -345,12 +333,12 @@ class OpenCLBackend:
         cl.enqueue_copy(self.queue, rows, samples)
         order_seeds = np.ascontiguousarray(orders[:, later], dtype=np.uint32)
         self._launch_2d("block_rows", n_k, rect.n_pixels * n_later, rows,
-                        cl.Buffer(self.context, ro, hostbuf=order_seeds), np.uint32(n_k), np.uint32(prm.s * prm.M))
+                        cl.Buffer(self.context, ro, hostbuf=order_seeds), np.uint32(n_k), np.uint32(prm.N))
         aij, u = self._array_cells(req)
         self._launch_2d(
             "generate_rows_centered" if centered else "generate_rows", n_k, n_pd,
             buf, np.uint32(at), tab, aij, u, rows,
-            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(offsets, dtype=np.uint32)), np.uint32(prm.s * prm.M),
+            cl.Buffer(self.context, ro, hostbuf=np.ascontiguousarray(offsets, dtype=np.uint32)), np.uint32(prm.N),
             np.uint32(n_k), np.uint32(req.n_dims), np.uint32(E), np.uint32(Es), np.uint32(prm.s), np.uint32(prm.M),
             np.float32(req.jitter),
         )

@@ -13,7 +13,7 @@ block and column become build constants) and a third kernel,
 ``vector_rows``, computes the later blocks' rows once per (pixel, block,
 sample) before the values.
 
-Which requests take it (:func:`shape`): the orthogonal-array samplers, any
+Which requests take it (:func:`oa_shape`): the orthogonal-array samplers, any
 offset, when
 
 - a rectangle is whole pixels with at least 8 sample positions (the tables,
@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import catalogue_types
+from ..params import OAParams, PointSetParams
 from ..reference.hashes import walk_mask
 from ..request import MAX_ARRAY_CELLS, Rect, Request
 
@@ -217,7 +218,7 @@ class BaselineShape(_Rows):
 
 def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:
     """The vector program of a ``jittered2d`` or ``cmj2d`` rectangle, or None
-    (other samplers, and the limits of :func:`shape`)."""
+    (other samplers, and the limits of :func:`oa_shape`)."""
     kind = req.construction.vector_kind  # its catalogue entry names the kernel (VBASELINE), or 0
     if not kind or rect.n_k != len(req.samples) or rect.n_k < LANES or not 1 <= req.n_dims <= MAX_WHOLE_ROWS:
         return None
@@ -227,11 +228,20 @@ def baseline_shape(req: Request, rect: Rect) -> BaselineShape | None:
     return shp if max(walk_rounds(n) for n in walks) <= MAX_ROUNDS else None
 
 
-def shape(req: Request, rect: Rect) -> Shape | None:
+def shape(req: Request, rect: Rect) -> Shape | BaselineShape | None:
     """The vector program for rectangle ``rect`` of ``req``, or None when the
-    rectangle does not take the vector path (module docstring)."""
+    rectangle does not take the vector path: an orthogonal array's
+    (:func:`oa_shape`), a padded 2D grid's (:func:`baseline_shape`), or none
+    for the other samplers."""
+    make = _SHAPES.get(type(req.params))
+    return None if make is None else make(req, rect)
+
+
+def oa_shape(req: Request, rect: Rect) -> Shape | None:
+    """The vector program of an orthogonal array's rectangle ``rect`` of ``req``,
+    or None when the rectangle does not take the vector path (module docstring)."""
     prm = req.params
-    if req.construction.family != "oa" or rect.n_k != len(req.samples) or rect.n_k < LANES:
+    if rect.n_k != len(req.samples) or rect.n_k < LANES:
         return None
     if not 1 <= req.n_dims <= MAX_DIMS:
         return None
@@ -247,13 +257,17 @@ def shape(req: Request, rect: Rect) -> Shape | None:
     else:
         return None
     dims = tuple(req.dims.tolist())
-    shp = Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.block_dims, req.offset, s_packed, sub,
-                req.construction.partner_cell_key, dims if max(dims) >= prm.block_dims else ())
-    if shp.later and prm.s * prm.M * shp.record_words > MAX_ARRAY_CELLS:
+    shp = Shape(prm.s, prm.M, req.n_dims, rect.n_k, prm.B, req.offset, s_packed, sub,
+                req.construction.partner_cell_key, dims if max(dims) >= prm.B else ())
+    if shp.later and prm.N * shp.record_words > MAX_ARRAY_CELLS:
         return None  # the rows' records would not fit
-    if shp.later and prm.s * prm.M >= MAX_ROWS16:
+    if shp.later and prm.N >= MAX_ROWS16:
         return None  # vector_rows walks in 16-bit lanes
     return shp
+
+
+#: The vector program of each parameter type that has one (:func:`shape`).
+_SHAPES = {OAParams: oa_shape, PointSetParams: baseline_shape}
 
 
 def row_records(req: Request, shp: Shape) -> np.ndarray:
@@ -270,14 +284,14 @@ def row_records(req: Request, shp: Shape) -> np.ndarray:
     8 samples and takes its column's field from it, instead of gathering its
     own two cells per value."""
     prm = req.params
-    N = prm.s * prm.M
+    N = prm.N
     rows = np.arange(N, dtype=np.uint32)[:, None]
-    cols = np.arange(prm.block_dims, dtype=np.uint32)[None, :]
-    aij, u = (np.broadcast_to(c, (N, prm.block_dims)).astype(np.uint32)
+    cols = np.arange(prm.B, dtype=np.uint32)[None, :]
+    aij, u = (np.broadcast_to(c, (N, prm.B)).astype(np.uint32)
               for c in req.construction.cells(rows, cols, prm))
     cell = aij | (u << np.uint32(shp.a_bits)) if shp.sub else aij
     per_word, out = 32 // shp.cell_bits, np.zeros((N, shp.record_words), np.uint32)
-    for c in range(prm.block_dims):
+    for c in range(prm.B):
         out[:, c // per_word] |= cell[:, c] << np.uint32((c % per_word) * shp.cell_bits)
     return out
 

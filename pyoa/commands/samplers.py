@@ -116,11 +116,7 @@ def _in_base(name: str, choices, base: int, dims: int | None) -> list[SppChoice]
     a sampler without a base refuses it, with its own message, as
     :func:`pyoa.sampler` does."""
     entry = get(name)
-    rebased = []
-    for c in choices:
-        prm = entry.with_base(entry.solve(c.spp, dims, None), base)
-        rebased.append(SppChoice(c.spp, prm.s, prm.strength, prm.block_dims, entry.detail(prm)))
-    return rebased
+    return [entry.choice(entry.with_base(entry.solve(c.spp, dims, None), base)) for c in choices]
 
 
 def cmd_spp(args) -> int:
@@ -134,19 +130,7 @@ def cmd_spp(args) -> int:
     shown = choices[: args.limit]
     if args.base is not None:
         shown = _in_base(args.sampler, shown, args.base, args.dims)
-    if get(args.sampler).family == "oa":
-        print(f"{'spp':>9s} {'s':>5s} {'t':>3s} {'dims/block':>10s}")
-        for c in shown:
-            print(f"{c.spp:9d} {c.s:5d} {c.strength:3d} {c.block_dims:10d}")
-    elif get(args.sampler).family == "progressive":  # any count; the base of each (given or default)
-        # full nets b^m: the largest m with b^m <= spp (aligned blocks of b^m samples are nets)
-        print(f"{'spp':>9s} {'base':>5s} {'full nets':>10s} {'dims/block':>10s}")
-        for c in shown:
-            print(f"{c.spp:9d} {c.s:5d} {f'{c.s}^{c.strength}':>10s} {c.block_dims:10d}")
-    else:  # comparison samplers: their grid (if any) instead of s and t
-        print(f"{'spp':>9s} {'grid':>11s}")
-        for c in shown:
-            print(f"{c.spp:9d} {c.detail or '-':>11s}")
+    print("\n".join(get(args.sampler).spp_table(shown)))  # the columns of its family
     if len(choices) > args.limit:
         print(f"... {len(choices) - args.limit} more (use --near N or --limit)")
     return 0
