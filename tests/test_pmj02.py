@@ -128,10 +128,11 @@ def test_constants():
 
 
 def test_keys_are_new_odd_uint32():
-    ours = {name: getattr(R, name) for name in ("PMJ02_KEY", "PMJ02_SHIFT_KEY", "PMJ02_BUILD_KEY", "PMJ02_DRAW_KEY")}
+    ours = {name: getattr(R, name) for name in ("PMJ02_KEY", "PMJ02_SHIFT_KEY")}
+    ours.update({name: getattr(B, name) for name in ("PMJ02_BUILD_KEY", "PMJ02_DRAW_KEY")})
     others = {}
     for m in pkgutil.iter_modules(reference.__path__):
-        if m.name == "pmj02":
+        if m.name in ("pmj02", "pmj02_build"):
             continue
         module = importlib.import_module(f"pyoa.reference.{m.name}")
         others.update({k: v for k, v in vars(module).items() if k.endswith("_KEY") and isinstance(v, int)})
