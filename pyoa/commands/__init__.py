@@ -10,7 +10,18 @@
 (render, compare, reference and study run on a Dask cluster with
 ``--workers N`` or ``--scheduler ADDRESS``; in-process by default)
 
-One convention for every command (:data:`CONVENTION`, printed by ``pyoa --help``).
+One convention for every command (:data:`~pyoa.commands.options.CONVENTION`,
+printed by ``pyoa --help``).
+
+Each module of this package holds a group of commands and adds their parsers
+(``add_parsers(sub)``): :mod:`~pyoa.commands.samplers` (points, samplers,
+spp, backends, plot, spectrum), :mod:`~pyoa.commands.render` (render,
+compare, info, reference) and :mod:`~pyoa.commands.study`;
+:mod:`~pyoa.commands.options` holds what they share and
+:mod:`~pyoa.commands.main` the parser, the exit statuses and the streams.
+A command reads its options and calls a library function with a settings
+value (:class:`~pyoa.render.settings.RenderSettings`,
+:class:`~pyoa.study.StudySettings`); nothing below this package imports it.
 """
 
 from .main import main
