@@ -28,40 +28,5 @@ True
 
 from __future__ import annotations
 
-import numpy as np
-
-from .reference.hashes import BLOCK_KEY, PIXEL_KEY
-
-U32 = np.uint32
-
-
-def _u32(x) -> np.ndarray:
-    return np.asarray(x, dtype=U32)
-
-
-def mix32(x) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.mix32` (Wellons' lowbias32)."""
-    x = _u32(x).copy()
-    x ^= x >> U32(16)
-    x *= U32(0x7FEB352D)
-    x ^= x >> U32(15)
-    x *= U32(0x846CA68B)
-    x ^= x >> U32(16)
-    return x
-
-
-def hash_pair(a, b, key: int) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.hashes.hash_pair` (never 0)."""
-    h = mix32(_u32(b) ^ mix32(_u32(a) ^ U32(key)))
-    return np.where(h == 0, U32(key), h)
-
-
-def pixel_seed(seed, pixel) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.pixel_seed`."""
-    return hash_pair(seed, pixel, PIXEL_KEY)
-
-
-def block_seed(p, block) -> np.ndarray:
-    """Vectorized :func:`pyoa.reference.block_seed` (block 0 keeps ``p``)."""
-    p, block = np.broadcast_arrays(_u32(p), _u32(block))
-    return np.where(block == 0, p, hash_pair(p, block, BLOCK_KEY))
+# One implementation: the generic hashes of pyoa._arrays, bound to NumPy.
+from ._numpy.hashes import U32, block_seed, hash_pair, mix32, pixel_seed  # noqa: F401

@@ -89,15 +89,46 @@ def test_jitter_amounts_and_every_value_of_a_small_array():
 
 @pytest.mark.parametrize("s", [2, 3, 5, 7, 11, 13])
 def test_bose_cells_of_a_prime_s_on_every_row_and_column(s):
-    """Over a prime s the Dr.Jit cell takes one remainder per entry (pyoa._drjit.oa.bose_cell);
-    every (row, column), the last column included, against NumPy's cells."""
-    from pyoa._numpy import oa as numpy_oa
+    """Over a prime s the cell takes one remainder per entry (pyoa._arrays.oa.bose_cell);
+    Dr.Jit's cells of every (row, column), the last column included, against the reference's."""
+    from pyoa.reference import oa as reference_oa
 
-    rows, cols = np.meshgrid(np.arange(s * s, dtype=np.uint32), np.arange(s + 1, dtype=np.uint32), indexing="ij")
-    got = _drjit.oa.bose_cell(UInt32(rows.ravel()), UInt32(cols.ravel()), s)
-    want = numpy_oa.bose_cell(rows.ravel(), cols.ravel(), s)
+    rows, cols = np.meshgrid(np.arange(s * s), np.arange(s + 1), indexing="ij")
+    got = _drjit.oa.bose_cell(UInt32(rows.ravel().astype(np.uint32)), UInt32(cols.ravel().astype(np.uint32)), s)
+    want = np.array([reference_oa.bose_cell(int(i), int(c), s) for i, c in zip(rows.ravel(), cols.ravel())]).T
     for g, w in zip(got, want):
         assert (np.asarray(g) == w).all()
+
+
+def test_the_namespace_defines_every_operation():
+    from pyoa import _arrays
+    from pyoa._drjit import ops
+
+    assert not [name for name in _arrays.OPERATIONS if not callable(getattr(ops, name, None))]
+
+
+def test_the_namespace_agrees_with_numpys():
+    """The operations whose Dr.Jit form differs from NumPy's: the power by bits, the fused
+    loops (lanes stop after different numbers of steps, per loop), the table gather."""
+    from pyoa._drjit import ops as dj
+    from pyoa._numpy import ops as npo
+
+    e = np.arange(32, dtype=np.uint32)
+    for base in (2, 3, 13, 4093):
+        assert (np.asarray(dj.power(base, UInt32(e))) == npo.power(base, e)).all()
+
+    def countdown(n, step):
+        return ((n, step), lambda n, step: n >= step, lambda n, step: (n - step, step))
+
+    n = np.arange(200, dtype=np.uint32)
+    steps = (np.uint32(3), np.uint32(41))
+    want = npo.while_loops([countdown(n, k) for k in steps], "test")
+    got = dj.while_loops([countdown(UInt32(n), UInt32(k)) for k in steps], "test")
+    for (g, _), (w, _) in zip(got, want):
+        assert (np.asarray(g) == w).all()
+    table = np.arange(100, 150, dtype=np.uint32)
+    idx = np.array([0, 49, 7, 7], dtype=np.uint32)
+    assert (np.asarray(dj.gather(table, UInt32(idx))) == npo.gather(table, idx)).all()
 
 
 @st.composite
@@ -131,7 +162,7 @@ def test_drjit_equals_numpy_on_random_parameters(smp, pixel):
 
 def test_division_is_correctly_rounded():
     """Dr.Jit rewrites ``x / literal`` as a multiply by the reciprocal; pyoa's floats must not."""
-    from pyoa._drjit.floats import divide
+    from pyoa._drjit.ops import divide
 
     x = np.float32(np.random.default_rng(0).random(50_000) * 7)
     F = dr.float32_array_t(UInt32)

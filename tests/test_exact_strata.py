@@ -28,7 +28,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from pyoa._numpy import floats as numpy_floats
+from pyoa._arrays import floats as array_floats
 from tests.helpers import assert_oa, make
 
 #: Seeds: 0 (the canonical array), small, random and the largest uint32.
@@ -120,12 +120,12 @@ def test_coarse_strata_exact_for_j_and_centered(backend, name, spp, strength, di
 
 
 def test_the_clamp_is_what_makes_them_exact(monkeypatch):
-    """Without the clamp (NumPy's cell_clamp replaced by the identity) the same
+    """Without the clamp (the cell_clamp of pyoa._arrays.floats replaced by the identity) the same
     checks fail: Bose s = 127 breaks the Latin hypercube in most columns. So the
     exact tests above can fail, and the clamp is what makes them pass."""
     x, _ = generate("bose", 127**2, 8, 8, "numpy")
     assert_latin(x, 127**2, "clamped")
-    monkeypatch.setattr(numpy_floats, "cell_clamp", lambda v, c, n: v)
+    monkeypatch.setattr(array_floats, "cell_clamp", lambda xp, v, c, n: v)
     y, _ = generate("bose", 127**2, 8, 8, "numpy")
     with pytest.raises(AssertionError, match="are not Latin hypercubes"):
         assert_latin(y, 127**2, "unclamped")

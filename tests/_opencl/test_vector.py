@@ -252,7 +252,7 @@ def test_walk_rounds_bounds_every_walk():
     random seeds. The reference's round function is checked against
     pyoa.reference.permute itself (walk, then the final shift) and is a
     bijection of [0, w]."""
-    from pyoa._numpy.hashes import _permute_round
+    from pyoa._numpy.hashes import permute_round as numpy_permute_round
     from pyoa._opencl import vector
 
     rng = np.random.default_rng(20240611)
@@ -266,7 +266,7 @@ def test_walk_rounds_bounds_every_walk():
         for p in seeds:
             rnd = [permute_round(x, p, w) for x in range(w + 1)]
             assert sorted(rnd) == list(range(w + 1)), f"round is not a bijection of [0, {w}] (l={l}, p={p})"
-            assert rnd == [int(v) for v in _permute_round(np.arange(w + 1, dtype=np.uint32), np.uint32(p), np.uint32(w))]
+            assert rnd == [int(v) for v in numpy_permute_round(np.arange(w + 1, dtype=np.uint32), np.uint32(p), np.uint32(w))]
             longest = 0
             for i in range(l):
                 x, rounds = rnd[i], 1
