@@ -185,11 +185,12 @@ def test_csv_written_in_blocks_equals_one_block(tmp_path, monkeypatch):
     whole large request would not fit where generate's result did); the file
     is the same whatever the block size."""
     from pyoa import commands
+    from pyoa.commands import samplers as sampler_commands
 
     args = ["points", "cmjnd", "--spp", "27", "--dims", "4", "--pixels", "7", "--pixel0", "5",
             "--backend", "numpy", "-q", "--out"]
     assert commands.main(args + [str(tmp_path / "one.csv")]) == 0
-    monkeypatch.setattr(cli, "CSV_BLOCK_VALUES", 2 * 27 * 6)  # two pixels per block
+    monkeypatch.setattr(sampler_commands, "CSV_BLOCK_VALUES", 2 * 27 * 6)  # two pixels per block
     assert commands.main(args + [str(tmp_path / "blocks.csv")]) == 0
     one = (tmp_path / "one.csv").read_text()
     assert (tmp_path / "blocks.csv").read_text() == one and one.count("\n") == 1 + 7 * 27
