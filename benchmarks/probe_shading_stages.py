@@ -127,7 +127,7 @@ def drive(tr, sc, cam, ps, pixel, sample_index, x, u, radiance, spent, clock, rr
                 if extend:
                     sh.sample_lobes(h, F)
                 t[5] = now(clock, ts)
-                sh.other_kinds(h, extend, F)
+                sh.other_kinds(h, extend, sc.kinds, F)
                 t[6] = now(clock, ts)
                 sh.shadow_rays(h, ps.mis, F)
                 t[7] = now(clock, ts)

@@ -231,9 +231,9 @@ def test_docs_state_the_compile_time_that_the_render_prints():
 def test_docs_say_which_cornell_surfaces_are_one_sided():
     """The code shades every surface two-sided (the normal turned towards the ray) and lets emitters emit on
     their front only; Mitsuba's cornell_box() is one-sided. No doc may call pyoa's surfaces one-sided."""
-    from pyoa.render import bsdf
+    from pyoa.render import bsdfs
 
-    assert "every surface is two-sided" in " ".join(bsdf.__doc__.split())
+    assert "every surface is two-sided" in " ".join(bsdfs.__doc__.split())
     text = " ".join((ROOT / "docs" / "rendering.md").read_text(encoding="utf-8").split())
     assert "every surface is one-sided" not in text
     assert "pyoa shades every surface two-sided" in text and "In Mitsuba each surface is one-sided" in text

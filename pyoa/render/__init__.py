@@ -5,7 +5,7 @@ reference), OpenImageIO for images.
 Modules: :mod:`.render` (``render`` and ``plan``: batches, threads, memory),
 :mod:`.settings` (a render's settings as one value, ``RenderSettings``),
 :mod:`.scene` (scene files: validation, shapes, camera),
-:mod:`.bsdf` (materials: sampling, evaluation, pdfs in a local frame),
+:mod:`.bsdfs` (materials, one module per BSDF: scene keys, sampling, evaluation, pdfs),
 :mod:`.geometry` (frames and small vector helpers), :mod:`.integrator`
 (the wavefront path tracer), :mod:`.image` (EXR/PNG output).
 """

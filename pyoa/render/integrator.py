@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..hashes import U32, hash_pair
-from . import bsdf
+from . import bsdfs
 from .camera import PerspectiveCamera, check_filter, filter_offsets
 from .emitters import Emitters
 from .geometry import dot, frame, to_local, to_world
@@ -323,9 +323,10 @@ class Integrator:
         pdf_light = self.emitters.pdf_area(tri) * t**2 / np.maximum(cos_l, 1e-12)
         return np.where(prev_delta, 1.0, power_heuristic(prev_pdf, pdf_light))
 
-    def next_event(self, p, off, ns, tb, wo, mat, beta, u):
+    def next_event(self, p, off, ns, tb, wo, front, mat, beta, u):
         """Next-event estimation at the smooth lanes: one point on an emitter
-        per lane (``u``: its two numbers), the BSDF and the MIS weight (power
+        per lane (``u``: its two numbers), the BSDF (``front``: which side of
+        the geometric normal ``wo`` lies on) and the MIS weight (power
         heuristic against BSDF sampling), and a shadow ray between the two
         points, the one at ``p`` moved ``off`` (:func:`offset_distance`) off
         its surface. Returns ``(lanes, contributions)`` of the unoccluded
@@ -336,7 +337,7 @@ class Integrator:
         dist = np.linalg.norm(to_q, axis=1)
         wi = to_q / np.maximum(dist, 1e-12)[:, None]
         cos_q = -dot(nq, wi)
-        f_cos, pdf_b = bsdf.evaluate(sc.materials, mat, wo, to_local(wi, tb[0], tb[1], ns))
+        f_cos, pdf_b = bsdfs.evaluate(sc.materials, mat, wo, to_local(wi, tb[0], tb[1], ns), front)
         pdf_l = pdf_area * dist**2 / np.maximum(cos_q, 1e-12)
         s = np.flatnonzero((cos_q > 0) & np.any(f_cos > 0, axis=1))
         if len(s) == 0:
@@ -391,28 +392,32 @@ class Integrator:
                 radiance[lane] += beta * le * w[:, None]  # lanes are distinct
             if depth == L.max_depth:
                 break
-            # shading frame facing the incoming ray (two-sided surfaces)
+            # shading frame facing the incoming ray (two-sided surfaces); front: the ray came from the side the
+            # geometric normal points to (glass refracts into the other side by its own index)
             ng = sc.normals[tri]
-            ns = np.where((dot(ng, d) > 0)[:, None], -ng, ng)
+            back = dot(ng, d) > 0
+            front = ~back
+            ns = np.where(back[:, None], -ng, ng)
             off = offset_distance(p, ng, self.reach[tri])  # new rays leave p this far along ns
             tb = frame(ns)
             wo = to_local(-d, *tb, ns)
             wo[:, 2] = np.maximum(wo[:, 2], 1e-9)
             mat = sc.material[tri]
             row = x[lane]
-            smooth = sc.materials.kind[mat] != bsdf.MIRROR
+            smooth = ~bsdfs.DELTA[sc.materials.kind[mat]]  # delta lobes get no light sample
             if np.any(smooth):
                 s = np.flatnonzero(smooth)
                 sel = slice(None) if len(s) == len(smooth) else s  # a view when every lane is smooth
                 hit, contrib, shadows = self.next_event(
-                    p[sel], off[sel], ns[sel], (tb[0][sel], tb[1][sel]), wo[sel], mat[sel], beta[sel],
+                    p[sel], off[sel], ns[sel], (tb[0][sel], tb[1][sel]), wo[sel], front[sel], mat[sel], beta[sel],
                     row[sel][:, L.pair(f"light{depth}")].astype(np.float64))
                 stats.rays += shadows
                 radiance[lane[s[hit]]] += contrib
             # continue the path with a BSDF sample
             if not (L.mis or depth < L.max_depth - 1):
                 break
-            wi, weight, pdf, delta = bsdf.sample(sc.materials, mat, wo, row[:, L.pair(f"bsdf{depth}")].astype(np.float64))
+            u = row[:, L.pair(f"bsdf{depth}")].astype(np.float64)
+            wi, weight, pdf, delta = bsdfs.sample(sc.materials, mat, wo, u, front)
             beta = beta * weight
             alive = np.any(beta > 0, axis=1)
             if depth >= RR_DEPTH:

@@ -48,10 +48,13 @@ Conventions are Mitsuba's:
   1.4-1.6x faster, but 1 to 2.5 % of the rays aimed exactly at a shared edge
   pass through it (docs/rendering.md, "Tracing"). The compiled shading
   follows it; the NumPy reference always traces robustly (embreex).
-* Materials: ``diffuse`` (``reflectance``, default 0.5 grey), ``ggx`` (a
+* Materials: one per BSDF of :mod:`pyoa.render.bsdfs`, whose module declares
+  its keys: ``diffuse`` (``reflectance``, default 0.5 grey), ``ggx`` (a
   rough conductor: ``specular`` colour, default white, and ``roughness``, the
-  GGX alpha as Mitsuba's ``alpha``, in (0, 1], default 0.1) and ``mirror``
-  (``tint``, default white). Colours are RGB in [0, 1].
+  GGX alpha as Mitsuba's ``alpha``, in (0, 1], default 0.1), ``mirror``
+  (``tint``, default white) and ``dielectric`` (smooth glass, as Mitsuba's:
+  ``int_ior``, default 1.5046, and ``ext_ior``, default 1.000277). Colours
+  are RGB in [0, 1].
 * Embree traces in float32, so the scene must be one float32 resolves
   (:func:`_check_float32_precision`): its largest coordinate (vertices and
   camera) at most ``MAX_POSITION_RATIO`` = 2^15 times its extent (the scene
@@ -80,7 +83,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pyoa.render.bsdf import Materials
+from pyoa.render.bsdfs import BSDFS, KINDS, Materials
 from pyoa.render.geometry import dot
 from pyoa.render.layout import MAX_DEPTH
 from pyoa.render.state import NotRegularFile, check_state_file, open_regular
@@ -440,12 +443,8 @@ _FILM = ("width", "height")
 _INTEGRATOR = ("max_depth", "mis", "robust_tracing")
 _SHAPE = ("type", "id", "to_world", "material", "emission", "file")
 _SHAPE_TYPES = ("rectangle", "cube", "mesh")
-# material type -> (bsdf kind, {key: default}, colour key)
-_MATERIAL_TYPES = {
-    "diffuse": ("diffuse", {"reflectance": [0.5, 0.5, 0.5]}, "reflectance"),
-    "ggx": ("ggx", {"specular": [1.0, 1.0, 1.0], "roughness": 0.1}, "specular"),
-    "mirror": ("mirror", {"tint": [1.0, 1.0, 1.0]}, "tint"),
-}
+#: Material types (a material's ``type``): the BSDFs of pyoa.render.bsdfs, each with its keys.
+_MATERIAL_TYPES = tuple(sorted(KINDS))
 
 
 def _no_duplicates(ctx: _Ctx):
@@ -523,14 +522,18 @@ def _materials(ctx: _Ctx, v) -> tuple[Materials, dict[str, int]]:
         if t not in _MATERIAL_TYPES:
             raise ctx.error(_join(where, "type"),
                             f"unknown material type {_show(t)}; valid: {', '.join(_MATERIAL_TYPES)}")
-        kind, defaults, colour_key = _MATERIAL_TYPES[t]
-        _check_keys(ctx, where, m, ("type",) + tuple(defaults))
-        colour = _vector(ctx, _join(where, colour_key), m.get(colour_key, defaults[colour_key]), lo=0, hi=1)
-        alpha = 0.0
-        if "roughness" in defaults:
-            alpha = _number(ctx, _join(where, "roughness"), m.get("roughness", defaults["roughness"]), 0, 1,
-                            lo_open=True)
-        specs.append((name, kind, tuple(float(c) for c in colour), alpha))
+        keys = BSDFS[KINDS[t]].KEYS
+        _check_keys(ctx, where, m, ("type",) + tuple(k.name for k in keys))
+        values = {}
+        for k in keys:  # each checked here, so that an error names its field
+            path = _join(where, k.name)
+            if k.size is None:
+                values[k.name] = _number(ctx, path, m.get(k.name, k.default), k.lo, k.hi, lo_open=k.lo_open,
+                                         hi_open=k.hi_open)
+            else:
+                values[k.name] = tuple(_vector(ctx, path, m.get(k.name, list(k.default)), n=k.size, lo=k.lo,
+                                               hi=k.hi))
+        specs.append((name, t, values))
     ids = {name: i for i, (name, *_rest) in enumerate(specs)}
     return Materials.build(specs), ids
 

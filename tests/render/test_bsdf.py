@@ -1,8 +1,10 @@
-"""Tests of :mod:`pyoa.render.bsdf`: sample/evaluate consistency, chi-square
-goodness of fit of the sampled directions against the reported pdf, pdf
-normalization against an independent visible-normal integral, energy
-conservation, reciprocity, the mirror delta lobe, material validation and
-finiteness at extreme inputs."""
+"""Tests of :mod:`pyoa.render.bsdfs` (the diffuse, mirror and GGX modules and
+the registry's dispatch; the glass: test_dielectric.py): sample/evaluate
+consistency, chi-square goodness of fit of the sampled directions against the
+reported pdf, pdf normalization against an independent visible-normal
+integral, energy conservation, reciprocity, the mirror delta lobe, the
+material table built from the modules' keys and finiteness at extreme
+inputs."""
 
 from __future__ import annotations
 
@@ -10,7 +12,9 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from pyoa.render.bsdf import DIFFUSE, GGX, KINDS, MIRROR, Materials, evaluate, sample
+from pyoa.render.bsdfs import BSDFS, KINDS, Materials, evaluate, pdf, sample
+
+DIFFUSE, MIRROR, GGX = KINDS["diffuse"], KINDS["mirror"], KINDS["ggx"]
 
 N_CHI2 = 200_000
 
@@ -31,8 +35,24 @@ def _random_dirs(rng, n, zmin=0.05):
     return np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
 
 
+#: Each reflective kind's colour key
+_COLOUR = {"diffuse": "reflectance", "mirror": "tint", "ggx": "specular"}
+
+
+def _spec(name, kind, color, alpha=0.5):
+    """A ``Materials.build`` spec of a reflective kind from its colour (and GGX roughness)."""
+    values = {_COLOUR[kind]: color}
+    if kind == "ggx":
+        values["roughness"] = alpha
+    return name, kind, values
+
+
+def _mats(*specs) -> Materials:
+    return Materials.build([_spec(*s) for s in specs])
+
+
 def _one(kind: str, color=(1.0, 1.0, 1.0), alpha=0.5) -> Materials:
-    return Materials.build([("m", kind, color, alpha)])
+    return _mats(("m", kind, color, alpha))
 
 
 class _Grid:
@@ -157,13 +177,9 @@ def test_sample_agrees_with_evaluate(kind, alpha):
 
 def test_mixed_lanes_match_single_kind_calls():
     rng = np.random.default_rng(2)
-    mats = Materials.build(
-        [
-            ("d", "diffuse", (0.8, 0.2, 0.1), 1.0),
-            ("m", "mirror", (0.9, 0.9, 0.5), 1.0),
-            ("g", "ggx", (0.95, 0.64, 0.54), 0.25),
-        ]
-    )
+    specs = [("d", "diffuse", (0.8, 0.2, 0.1)), ("m", "mirror", (0.9, 0.9, 0.5)),
+             ("g", "ggx", (0.95, 0.64, 0.54), 0.25)]
+    mats = _mats(*specs)
     n = 3000
     mat = rng.integers(0, 3, n)
     wo = _random_dirs(rng, n)
@@ -173,7 +189,7 @@ def test_mixed_lanes_match_single_kind_calls():
     f_cos, pdf_e = evaluate(mats, mat, wo, wi_e)
     for m in range(3):
         sel = mat == m
-        single = Materials.build([(mats.names[m], list(KINDS)[mats.kind[m]], tuple(mats.color[m]), mats.alpha[m])])
+        single = _mats(specs[m])
         z = np.zeros(sel.sum(), dtype=np.int64)
         r = sample(single, z, wo[sel], u[sel])
         for a, b in zip((wi, weight, pdf, delta), r):
@@ -307,7 +323,7 @@ def test_mirror_is_a_tinted_delta_reflection():
 def test_evaluate_is_zero_below_the_surface():
     rng = np.random.default_rng(5)
     n = 1000
-    mats = Materials.build([("d", "diffuse", (1, 1, 1), 1.0), ("g", "ggx", (1, 1, 1), 0.5)])
+    mats = _mats(("d", "diffuse", (1, 1, 1)), ("g", "ggx", (1, 1, 1), 0.5))
     mat = rng.integers(0, 2, n)
     wo = _random_dirs(rng, n)
     wi = _random_dirs(rng, n, zmin=0.0) * [1.0, 1.0, -1.0]
@@ -319,57 +335,83 @@ def test_evaluate_is_zero_below_the_surface():
 
 
 def test_build_arrays():
-    mats = Materials.build(
-        [("a", "diffuse", (0.1, 0.2, 0.3), 1.0), ("b", "ggx", (1, 1, 1), 0.2), ("c", "mirror", (0, 0, 0), 0)]
-    )
-    assert mats.names == ("a", "b", "c")
-    assert mats.kind.dtype == np.int32 and list(mats.kind) == [DIFFUSE, GGX, MIRROR]
-    assert mats.color.dtype == np.float64 and mats.color.shape == (3, 3)
-    assert mats.alpha.dtype == np.float64 and mats.alpha.shape == (3,)
-    assert mats.alpha[1] == 0.2
+    mats = Materials.build([("a", "diffuse", {"reflectance": (0.1, 0.2, 0.3)}),
+                            ("b", "ggx", {"specular": (1, 1, 1), "roughness": 0.2}),
+                            ("c", "mirror", {"tint": (0, 0, 0)}), ("d", "ggx", {}), ("e", "diffuse", {})])
+    assert mats.names == ("a", "b", "c", "d", "e")
+    assert mats.kind.dtype == np.int32 and list(mats.kind) == [DIFFUSE, GGX, MIRROR, GGX, DIFFUSE]
+    assert mats.params.dtype == np.float64 and mats.params.shape == (5, 4)
+    np.testing.assert_array_equal(mats.params[:3], [[0.1, 0.2, 0.3, 0], [1, 1, 1, 0.2], [0, 0, 0, 0]])
+    np.testing.assert_array_equal(mats.params[3:], [[1, 1, 1, 0.1], [0.5, 0.5, 0.5, 0]])  # the keys' defaults
     with pytest.raises(ValueError):
-        mats.color[0, 0] = 0.5  # read-only
-    assert KINDS == {"diffuse": 0, "mirror": 1, "ggx": 2}
+        mats.params[0, 0] = 0.5  # read-only
+
+
+def test_the_registry_keeps_the_kinds_of_the_bundled_scenes():
+    """The bundled scenes' images depend on the kind ids (the compiled
+    shading's first kind is the Lambertian): the registry keeps them, a new
+    BSDF goes at the end, and every module says what the renderer reads."""
+    assert list(KINDS) == ["diffuse", "mirror", "ggx", "dielectric"]
+    assert [m.NAME for m in BSDFS] == list(KINDS) and list(KINDS.values()) == [0, 1, 2, 3]
+    for m in BSDFS:
+        assert isinstance(m.DELTA, bool) and isinstance(m.LANES, bool) and m.KEYS
+        assert all(callable(getattr(m, f)) for f in ("params", "sample", "evaluate", "pdf", "sample_point",
+                                                    "evaluate_point"))
+        assert m.__doc__ and "References" in m.__doc__
 
 
 def test_build_unknown_kind_names_valid_kinds():
     with pytest.raises(ValueError) as exc:
-        Materials.build([("a", "glass", (1, 1, 1), 0.5)])
+        Materials.build([("a", "glass", {})])
     msg = str(exc.value)
     assert "glass" in msg and all(k in msg for k in KINDS)
 
 
+def test_build_unknown_key_names_the_valid_ones():
+    with pytest.raises(ValueError, match="diffuse has no key 'roughness'; valid: reflectance"):
+        Materials.build([("a", "diffuse", {"roughness": 0.1})])
+
+
 @pytest.mark.parametrize("color", [(1.5, 0, 0), (0, -0.1, 0), (0.5, 0.5), (0.5, 0.5, 0.5, 0.5), (np.nan, 0, 0), "red"])
 def test_build_rejects_bad_color(color):
-    with pytest.raises(ValueError, match="color"):
-        Materials.build([("a", "diffuse", color, 0.5)])
+    with pytest.raises(ValueError, match=r"'a': diffuse reflectance must be 3 numbers, each in \[0, 1\]"):
+        Materials.build([("a", "diffuse", {"reflectance": color})])
 
 
 @pytest.mark.parametrize("alpha", [0.0, -0.1, 1.5, np.nan, np.inf, "rough"])
-def test_build_rejects_bad_ggx_alpha(alpha):
-    with pytest.raises(ValueError, match="alpha"):
-        Materials.build([("a", "ggx", (1, 1, 1), alpha)])
+def test_build_rejects_bad_ggx_roughness(alpha):
+    with pytest.raises(ValueError, match=r"ggx roughness must be a number in \(0, 1\]"):
+        Materials.build([("a", "ggx", {"roughness": alpha})])
 
 
-def test_build_ignores_alpha_for_other_kinds_and_rejects_duplicates():
-    Materials.build([("a", "diffuse", (1, 1, 1), 0.0), ("b", "mirror", (1, 1, 1), 7.0)])
+def test_build_rejects_duplicates():
     with pytest.raises(ValueError, match="duplicate"):
-        Materials.build([("a", "diffuse", (1, 1, 1), 0.5), ("a", "mirror", (1, 1, 1), 0.5)])
+        Materials.build([("a", "diffuse", {}), ("a", "mirror", {})])
+
+
+def test_pdf_is_evaluate_s():
+    rng = np.random.default_rng(8)
+    n = 2000
+    mats = _mats(("d", "diffuse", (0.5, 0.5, 0.5)), ("m", "mirror", (1, 1, 1)), ("g", "ggx", (1, 1, 1), 0.3))
+    mat = rng.integers(0, 3, n)
+    wo = _random_dirs(rng, n)
+    wi = rng.normal(size=(n, 3))
+    wi /= np.linalg.norm(wi, axis=1)[:, None]
+    np.testing.assert_array_equal(pdf(mats, mat, wo, wi), evaluate(mats, mat, wo, wi)[1])
+    assert np.any(pdf(mats, mat, wo, wi) > 0) and np.all(pdf(mats, mat, wo, wi)[mat == MIRROR] == 0)
 
 
 # --------------------------------------------------------------------------- finiteness
 
 
 def test_outputs_finite_at_extremes():
-    mats = Materials.build(
-        [
-            ("d", "diffuse", (1, 1, 1), 1.0),
-            ("m", "mirror", (1, 1, 1), 1.0),
-            ("g0", "ggx", (1, 1, 1), 1e-9),  # clamped to 1e-3
-            ("g1", "ggx", (0.5, 0.5, 0.5), 1e-3),
-            ("g2", "ggx", (0.0, 0.0, 0.0), 0.5),
-            ("g3", "ggx", (1, 1, 1), 1.0),
-        ]
+    mats = _mats(
+        ("d", "diffuse", (1, 1, 1)),
+        ("m", "mirror", (1, 1, 1)),
+        ("g0", "ggx", (1, 1, 1), 1e-9),  # clamped to 1e-3
+        ("g1", "ggx", (0.5, 0.5, 0.5), 1e-3),
+        ("g2", "ggx", (0.0, 0.0, 0.0), 0.5),
+        ("g3", "ggx", (1, 1, 1), 1.0),
     )
     edge = [0.0, 2.0**-24, 0.5, 1.0 - 2.0**-24]
     us = np.array([(a, b) for a in edge for b in edge])
@@ -393,9 +435,7 @@ def test_outputs_finite_at_extremes():
 
 
 def test_invalid_wo_lanes_are_zero_not_nan():
-    mats = Materials.build(
-        [("d", "diffuse", (1, 1, 1), 1.0), ("g", "ggx", (1, 1, 1), 0.3), ("m", "mirror", (1, 1, 1), 0)]
-    )
+    mats = _mats(("d", "diffuse", (1, 1, 1)), ("g", "ggx", (1, 1, 1), 0.3), ("m", "mirror", (1, 1, 1)))
     wo = np.array([[1.0, 0.0, 0.0], [0.6, 0.0, -0.8], [1.0, 0.0, 0.0]])
     wi, weight, pdf, _ = sample(mats, np.array([0, 1, 2]), wo, np.full((3, 2), 0.3))
     assert np.all(np.isfinite(wi)) and np.all(weight == 0) and np.all(pdf == 0)

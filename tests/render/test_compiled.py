@@ -13,13 +13,13 @@ import textwrap
 import numpy as np
 import pytest
 
-from pyoa.render import bsdf as nb_ref
-from pyoa.render.compiled import bsdf as cb
+from pyoa.render import bsdfs
+from pyoa.render.compiled import bsdfs as cb
 from pyoa.render.compiled import integrator as ci
 from pyoa.render.render import render
 from pyoa.render.scene import load
 
-KINDS = (nb_ref.DIFFUSE, nb_ref.MIRROR, nb_ref.GGX)
+DIFFUSE, MIRROR, GGX, DIELECTRIC = (bsdfs.KINDS[k] for k in ("diffuse", "mirror", "ggx", "dielectric"))
 
 
 def _directions(rng, n):
@@ -32,29 +32,35 @@ def _directions(rng, n):
 
 @pytest.mark.parametrize("alpha", [1e-4, 0.05, 0.3, 1.0])
 def test_bsdf_sample_and_evaluate_mirror_the_reference(alpha):
+    """The compiled per-point dispatch (a chain built from the registry) gives
+    each kind's NumPy values: to rounding (the warps' polynomial sines), and
+    to the bit for the mirror and the glass, from either side."""
     rng = np.random.default_rng(int(alpha * 1e4))
     n = 600
-    color = np.array([0.9, 0.5, 0.2])
-    mats = nb_ref.Materials.build([("d", "diffuse", color, 0.5), ("m", "mirror", color, 0.5),
-                                   ("g", "ggx", color, alpha)])
+    color = (0.9, 0.5, 0.2)
+    mats = bsdfs.Materials.build([("d", "diffuse", {"reflectance": color}), ("m", "mirror", {"tint": color}),
+                                  ("g", "ggx", {"specular": color, "roughness": alpha}),
+                                  ("glass", "dielectric", {"int_ior": 1.0 + alpha})])
     wo = _directions(rng, n)
     wi_any = rng.normal(size=(n, 3))
     wi_any /= np.linalg.norm(wi_any, axis=1)[:, None]
     u = rng.random((n, 2))
     u[:5] = [[0.5, 0.5], [0.0, 0.0], [0.5, 0.0], [0.0, 0.5], [np.nextafter(1, 0)] * 2]  # warp corners
-    for kind, mat in zip(KINDS, range(3)):
+    front = rng.random(n) < 0.5
+    for mat, kind in enumerate(mats.kind):
         ids = np.full(n, mat)
-        wi, weight, pdf, delta = nb_ref.sample(mats, ids, wo, u)
-        f_cos, pdf_e = nb_ref.evaluate(mats, ids, wo, wi_any)
+        wi, weight, pdf, delta = bsdfs.sample(mats, ids, wo, u, front)
+        f_cos, pdf_e = bsdfs.evaluate(mats, ids, wo, wi_any, front)
+        exact = kind in (MIRROR, DIELECTRIC)
         for i in range(n):
-            got = cb.sample(kind, *color, mats.alpha[mat], *wo[i], *u[i])
-            np.testing.assert_allclose(got[:3], wi[i], rtol=1e-12, atol=1e-15)
-            np.testing.assert_allclose(got[3:6], weight[i], rtol=1e-12, atol=1e-15)
-            np.testing.assert_allclose(got[6], pdf[i], rtol=1e-12, atol=1e-15)
+            got = cb.sample(kind, *mats.params[mat], front[i], *wo[i], *u[i])
+            ev = cb.evaluate(kind, *mats.params[mat], front[i], *wo[i], *wi_any[i])
+            want, want_ev = (*wi[i], *weight[i], pdf[i]), (*f_cos[i], pdf_e[i])
+            if exact:
+                assert got[:7] == want and ev == want_ev, (kind, i)
+            np.testing.assert_allclose(got[:7], want, rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(ev, want_ev, rtol=1e-12, atol=1e-15)
             assert got[7] == delta[i]
-            ev = cb.evaluate(kind, *color, mats.alpha[mat], *wo[i], *wi_any[i])
-            np.testing.assert_allclose(ev[:3], f_cos[i], rtol=1e-12, atol=1e-15)
-            np.testing.assert_allclose(ev[3], pdf_e[i], rtol=1e-12, atol=1e-15)
 
 
 def _noise_check(scene, **kw):
@@ -80,7 +86,7 @@ def _noise_check(scene, **kw):
         assert diff <= 5 * se + 1e-7, f"channel {c}: image means differ by {diff:.3g}, standard error {se:.3g}"
 
 
-@pytest.mark.parametrize("name", ["cornell", "dof7d", "deep"])
+@pytest.mark.parametrize("name", ["cornell", "dof7d", "deep", "cornell-glass"])
 def test_compiled_and_numpy_agree_within_their_noise(name):
     _noise_check(load(name), sampler="bose", spp=25, width=24, height=24)
 
@@ -208,11 +214,15 @@ def test_numba_cache_follows_every_source_the_compiled_code_comes_from(tmp_path)
                 where = "render/" if node.level == 2 else ""
                 names = [node.module] if node.module else [a.name for a in node.names]
                 for n in names:
-                    imported.add(where + n.replace(".", "/") + ".py")
+                    rel = where + n.replace(".", "/")
+                    imported.add(rel + "/__init__.py" if (root / rel).is_dir() else rel + ".py")
                     if "." in n:
                         imported.add(where + n.rsplit(".", 1)[0].replace(".", "/") + "/__init__.py")
     assert any(name.startswith("_numba/") for name in imported)  # the hashes are followed too
+    assert "render/bsdfs/__init__.py" in imported  # the registry the dispatch is built from
     assert imported <= set(pkg.SOURCES), imported - set(pkg.SOURCES)
+    # every BSDF module is compiled in (its one-point forms): all are sources, a new one without a line
+    assert {f"render/bsdfs/{p.name}" for p in (root / "render" / "bsdfs").glob("*.py")} <= set(pkg.SOURCES)
     # the digest changes with any byte of any source
     for rel in pkg.SOURCES:
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
@@ -264,14 +274,20 @@ def test_lane_loops_vectorize():
     rng = np.random.default_rng(0)
     F = rng.random(sh.SCRATCH) + 0.5
     C = rng.random(cam.SCRATCH)
-    calls = {"head": (sh, sh.CHUNK, 2, True, F), "light_directions": (sh, sh.CHUNK, F),
-             "shadow_rays": (sh, sh.CHUNK, True, F), "sample_lobes": (sh, sh.CHUNK, F), "new_rays": (sh, sh.CHUNK, F),
-             "ggx_evaluate": (sh, sh.CHUNK, F), "ggx_sample": (sh, sh.CHUNK, F),
-             "_rays": (cam, cam.LANES, True, True, 64, 48, 0.5, 0.4, tuple(rng.random(9)), (1.0, 2.0, 3.0), 0.1, 2.0,
-                       (0.1, 0.2, 0.3), C)}
-    for name, (module, *args) in calls.items():
+    calls = {"head": (sh.head, sh.CHUNK, 2, True, F), "light_directions": (sh.light_directions, sh.CHUNK, F),
+             "shadow_rays": (sh.shadow_rays, sh.CHUNK, True, F), "sample_lobes": (sh.sample_lobes, sh.CHUNK, F),
+             "new_rays": (sh.new_rays, sh.CHUNK, F),
+             "_rays": (cam._rays, cam.LANES, True, True, 64, 48, 0.5, 0.4, tuple(rng.random(9)), (1.0, 2.0, 3.0), 0.1,
+                       2.0, (0.1, 0.2, 0.3), C)}
+    for kind, loops in sh.LANE_LOOPS.items():  # each BSDF's lane form (GGX, glass)
+        name = bsdfs.BSDFS[kind].NAME
+        calls[f"{name} evaluate"], calls[f"{name} sample"] = (loops[0], sh.CHUNK, F), (loops[1], sh.CHUNK, F)
+    assert {"ggx sample", "dielectric sample"} <= set(calls)
+    for name, (fn, *args) in calls.items():
+        if name == "dielectric evaluate":
+            continue  # two delta lobes: their value is 0, nothing to multiply
         # a copy compiled here: numba does not keep the assembly of cached code
-        f = njit(nogil=True, error_model="numpy")(getattr(module, name).py_func)
+        f = njit(nogil=True, error_model="numpy")(fn.py_func)
         f(*args)
         asm = f.inspect_asm(f.signatures[0])
         packed = len(re.findall(r"\bv?mulpd\b", asm))
@@ -279,14 +295,17 @@ def test_lane_loops_vectorize():
 
 
 def test_sin_cos_is_within_two_ulps_of_libm():
-    """The compiled warps' sines and cosines (geometry.sin_cos, polynomials
+    """The compiled warps' sines and cosines (bsdfs.warps.sin_cos, polynomials
     on [-pi/4, pi/4]) are within 2 ulps of the C library's, as its docstring
     says: on a dense grid, at random points, at the ends and near zero."""
     import math
 
     from numba import njit
 
-    from pyoa.render.compiled.geometry import sin_cos
+    from pyoa.render.bsdfs import warps
+    from pyoa.render.compiled.forms import compiled
+
+    sin_cos = compiled(warps.sin_cos)
 
     @njit
     def both(xs):
@@ -311,7 +330,7 @@ def test_camera_rays_are_the_reference_s(name, filter):
     camera's rays (Integrator.camera_rays): the same bits for a pinhole
     camera, moving (bounce9d) or not (cornell), with either filter; through a
     thin lens (dof7d) within 2 ulps of each ray's largest component, because
-    its disk point takes its sine and cosine from geometry.sin_cos instead of
+    its disk point takes its sine and cosine from bsdfs.warps.sin_cos instead of
     NumPy's."""
     from pyoa.render.camera import filter_offsets
     from pyoa.render.compiled import camera as cam
@@ -343,12 +362,13 @@ def test_scratch_rows_do_not_overlap():
     from the next row's start, and the scratch holds them all."""
     from pyoa.render.compiled import shading as sh
 
-    sizes_and_imports = ("CHUNK", "ROW", "SCRATCH", "HIT_FIELDS", "DIFFUSE", "MIRROR", "GGX", "RR_KEY")
+    sizes_and_imports = ("CHUNK", "ROW", "SCRATCH", "HIT_FIELDS", "RR_KEY")
     rows = sorted(v for k, v in vars(sh).items()
                   if k.isupper() and not k.startswith("_") and isinstance(v, int) and k not in sizes_and_imports)
     assert rows == [k * sh.ROW for k in range(len(rows))]
     assert sh.ROW >= sh.CHUNK and (sh.ROW * 8) % 4096 != 0 and rows[-1] + sh.ROW <= sh.SCRATCH
-    assert sh.CB - sh.V0X == (sh.HIT_FIELDS - 1) * sh.ROW  # gather copies hit_data's row into V0X .. CB
+    assert sh.M3 - sh.V0X == (sh.HIT_FIELDS - 1) * sh.ROW  # gather copies hit_data's row into V0X .. M3
+    assert (sh.M3 - sh.M0) // sh.ROW + 1 == bsdfs.PARAMS  # a material's numbers
 
 
 @pytest.mark.parametrize("n_emitters", [1, 2, 3, 7, 8, 33])
@@ -387,29 +407,36 @@ def test_emitter_choice_is_the_reference(n_emitters):
 
 
 @pytest.mark.parametrize("extend", [True, False])
-def test_ggx_lanes_are_the_per_point_bsdf(extend):
-    """other_kinds shades the GGX lanes of a chunk packed into rows of their
-    own, in a vectorized loop: each GGX lane gets, bit for bit, what the
-    per-point evaluate and sample (which mirror the reference) give it,
-    grazing and below-the-surface directions and the warps' corners
-    included, and the other lanes keep what light_directions and
-    sample_lobes wrote (the sample only when the path goes on)."""
-    from pyoa.render.bsdf import DIFFUSE, GGX, MIRROR
+def test_other_kinds_are_the_per_point_bsdf(extend):
+    """other_kinds shades the lanes of every kind but the first, one kind
+    after another: GGX and glass lanes packed into rows of their own, in
+    vectorized loops (their lane forms), the mirror's one lane at a time.
+    Each such lane gets, bit for bit, what the per-point evaluate and sample
+    (which mirror the reference) give it, grazing and below-the-surface
+    directions, both sides of the glass and the warps' corners included;
+    the Lambertian lanes keep what light_directions and sample_lobes wrote,
+    and so do the lanes of a kind the scene does not have (``kinds``)."""
     from pyoa.render.compiled import shading as sh
 
     rng = np.random.default_rng(11)
     h = sh.CHUNK
     F = np.full(sh.SCRATCH, np.nan)
     row = lambda r: F[r:r + h]  # noqa: E731
-    kind = rng.choice([DIFFUSE, MIRROR, GGX], size=h, p=[0.4, 0.2, 0.4]).astype(np.float64)
+    kind = rng.choice([DIFFUSE, MIRROR, GGX, DIELECTRIC], size=h, p=[0.3, 0.2, 0.3, 0.2]).astype(np.float64)
     kind[:6] = GGX  # the warps' corners and the normal incidence below are GGX lanes
+    kind[6:12] = DIELECTRIC
     row(sh.KIND)[:] = kind
-    for r in (sh.CR, sh.CG, sh.CB):
-        row(r)[:] = rng.random(h)
-    row(sh.ALPHA)[:] = rng.choice([1e-4, 0.05, 0.3, 1.0], size=h)
+    params = rng.random((h, 4))
+    params[:, 3] = rng.choice([1e-4, 0.05, 0.3, 1.0], size=h)  # GGX roughness
+    glass = kind == DIELECTRIC
+    params[glass, 0] = rng.choice([1.0, 1.33, 1.5046 / 1.000277, 2.4], size=glass.sum())  # eta
+    for r, v in zip((sh.M0, sh.M1, sh.M2, sh.M3), params.T):
+        row(r)[:] = v
+    row(sh.FRONT)[:] = rng.random(h) < 0.5
     wo = _directions(rng, h)
     wo[-8:, 2] = -np.abs(wo[-8:, 2])  # below the surface: the sample's guard
     wo[5] = [0.0, 0.0, 1.0]  # normal incidence: the visible-normal frame's fallback tangent
+    wo[6:9] = [[0.99, 0.0, np.sqrt(1 - 0.99**2)]] * 3  # grazing: total internal reflection from inside the glass
     wi = rng.normal(size=(h, 3))
     wi /= np.linalg.norm(wi, axis=1)[:, None]
     for r, v in zip((sh.WOX, sh.WOY, sh.WOZ, sh.IX, sh.IY, sh.IZ), (*wo.T, *wi.T)):
@@ -423,50 +450,34 @@ def test_ggx_lanes_are_the_per_point_bsdf(extend):
         row(r)[:] = rng.random(h)  # as light_directions would leave them
     sh.sample_lobes(h, F)
     before = F.copy()
-    sh.other_kinds(h, extend, F)
+    kinds = np.ones(len(bsdfs.BSDFS), dtype=bool)
+    sh.other_kinds(h, extend, kinds, F)
     bits = lambda values: np.array(values, np.float64).view(np.uint64)  # noqa: E731 - -0.0 is not 0.0
-    for k in np.flatnonzero(kind == GGX):
-        args = (GGX, *(F[r + k] for r in (sh.CR, sh.CG, sh.CB, sh.ALPHA, sh.WOX, sh.WOY, sh.WOZ)))
-        want = cb.evaluate(*args, *wi[k])
-        assert np.array_equal(bits([F[r + k] for r in evaluated]), bits(want)), k
+    shaded = np.flatnonzero(kind != DIFFUSE)
+    for k in shaded:
+        args = (int(kind[k]), *params[k], F[sh.FRONT + k] != 0.0, *wo[k])
+        assert np.array_equal(bits([F[r + k] for r in evaluated]), bits(cb.evaluate(*args, *wi[k]))), k
         ix, iy, iz, wr, wg, wb, pdf, delta = cb.sample(*args, *u[k])
         want = [ix, iy, iz, wr, wg, wb, pdf, float(delta)] if extend else [before[r + k] for r in sampled]
         assert np.array_equal(bits([F[r + k] for r in sampled]), bits(want)), k
-    assert np.count_nonzero(kind == GGX) > 50 and np.any(wo[kind == GGX, 2] < 0)
-    others = np.flatnonzero(kind != GGX)
+    for which in (GGX, MIRROR, DIELECTRIC):
+        assert np.count_nonzero(kind == which) > 30 and np.any(wo[kind == which, 2] < 0)
+    reflected = (kind == DIELECTRIC) & (F[sh.NIZ:sh.NIZ + h] > 0)
+    if extend:
+        assert 0 < reflected.sum() < glass.sum()  # the glass lanes both reflect and refract
+    others = np.flatnonzero(kind == DIFFUSE)
     for r in (*evaluated, *sampled):
         assert np.array_equal(F[r + others], before[r + others])
-
-
-def test_a_kind_without_lanes_is_shaded_per_point():
-    """other_kinds' promise for a BSDF added without a lane form: its lanes
-    get what the per-point evaluate and sample give (kind 3, which the
-    per-point functions shade as they shade any kind they do not name),
-    not the Lambertian values light_directions and sample_lobes left."""
-    from pyoa.render.bsdf import DIFFUSE, KINDS
-    from pyoa.render.compiled import shading as sh
-
-    new_kind = float(max(KINDS.values()) + 1)
-    rng = np.random.default_rng(3)
-    h = 64
-    F = rng.random(sh.SCRATCH)
-    F[sh.KIND:sh.KIND + h] = np.where(np.arange(h) % 2 == 0, new_kind, float(DIFFUSE))
-    wo, wi = _directions(rng, h), _directions(rng, h)
-    for r, v in zip((sh.WOX, sh.WOY, sh.WOZ, sh.IX, sh.IY, sh.IZ), (*wo.T, *wi.T)):
-        F[r:r + h] = v
-    sh.sample_lobes(h, F)
-    before = F.copy()
-    sh.other_kinds(h, True, F)
-    for k in range(h):
-        args = (int(F[sh.KIND + k]), *(F[r + k] for r in (sh.CR, sh.CG, sh.CB, sh.ALPHA, sh.WOX, sh.WOY, sh.WOZ)))
-        got_eval = [F[r + k] for r in (sh.FR, sh.FG, sh.FB, sh.PDF_B)]
-        got_sample = [F[r + k] for r in (sh.NIX, sh.NIY, sh.NIZ, sh.WR, sh.WG, sh.WB, sh.PDF, sh.DELTA)]
-        if k % 2:  # Lambertian: untouched
-            assert got_eval == [before[r + k] for r in (sh.FR, sh.FG, sh.FB, sh.PDF_B)]
-            continue
-        assert got_eval == list(cb.evaluate(*args, *wi[k]))
-        ix, iy, iz, wr, wg, wb, pdf, delta = cb.sample(*args, F[sh.BSDF_U + k], F[sh.BSDF_V + k])
-        assert got_sample == [ix, iy, iz, wr, wg, wb, pdf, float(delta)]
+    # a kind the scene does not have is not shaded: its lanes keep the first kind's values
+    for missing in (MIRROR, GGX, DIELECTRIC):
+        G = before.copy()
+        kinds[:] = True
+        kinds[missing] = False
+        sh.other_kinds(h, extend, kinds, G)
+        lanes, rest = np.flatnonzero(kind == missing), np.flatnonzero((kind != missing) & (kind != DIFFUSE))
+        for r in (*evaluated, *sampled):
+            assert np.array_equal(G[r + lanes], before[r + lanes])
+            assert np.array_equal(G[r + rest], F[r + rest])
 
 
 @pytest.mark.parametrize("name", ["cornell", "deep"])

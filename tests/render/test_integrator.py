@@ -330,7 +330,7 @@ def ggx_reflected_radiance(f0, alpha, le=LE, a=LIGHT_A, b=LIGHT_B, h=LIGHT_H, n=
     origin lit by the light of :func:`light_scene`: the integral over the light
     of f(wo, wi) cos(theta_i) Le cos(theta_l) / r^2, with f the Cook-Torrance
     BRDF (GGX D, Smith height-correlated G2, Schlick F), written here
-    independently of :mod:`pyoa.render.bsdf`."""
+    independently of :mod:`pyoa.render.bsdfs`."""
     xs = (np.arange(n) + 0.5) / n * a - a / 2
     ys = (np.arange(n) + 0.5) / n * b - b / 2
     X, Y = np.meshgrid(xs, ys, indexing="ij")

@@ -12,7 +12,9 @@ import pytest
 
 pytest.importorskip("trimesh")
 from pyoa.render import scene as S  # noqa: E402
-from pyoa.render.bsdf import DIFFUSE, GGX, MIRROR  # noqa: E402
+from pyoa.render.bsdfs import KINDS  # noqa: E402
+
+DIFFUSE, MIRROR, GGX, DIELECTRIC = (KINDS[k] for k in ("diffuse", "mirror", "ggx", "dielectric"))
 
 WHITE = [0.885809, 0.698859, 0.666422]
 RADIANCE = [18.387, 13.9873, 6.75357]
@@ -143,9 +145,9 @@ def test_cornell_materials_and_walls(cornell):
     m = cornell.materials
     assert m.names == ("white", "red", "green")
     assert np.all(m.kind == DIFFUSE)
-    np.testing.assert_allclose(m.color[0], WHITE)
-    np.testing.assert_allclose(m.color[1], [0.570068, 0.0430135, 0.0443706])
-    np.testing.assert_allclose(m.color[2], [0.105421, 0.37798, 0.076425])
+    np.testing.assert_allclose(m.params[0, :3], WHITE)
+    np.testing.assert_allclose(m.params[1, :3], [0.570068, 0.0430135, 0.0443706])
+    np.testing.assert_allclose(m.params[2, :3], [0.105421, 0.37798, 0.076425])
     idx = cornell.shape_index
     expect = {0: [0, 1, 0], 1: [0, -1, 0], 2: [0, 0, 1], 3: [-1, 0, 0], 4: [1, 0, 0]}  # floor ceiling back green red
     for shape, normal in expect.items():
@@ -269,7 +271,37 @@ def test_the_valid_minimal_scene_loads(tmp_path):
     assert sc.name == "x" and len(sc.triangles) == 4 and list(sc.emitters) == [2, 3]
     assert (sc.width, sc.height, sc.max_depth, sc.mis) == (256, 256, 5, True)  # defaults
     assert list(sc.materials.kind) == [DIFFUSE, GGX, MIRROR]
-    assert sc.materials.alpha[1] == pytest.approx(0.2)
+    np.testing.assert_array_equal(sc.materials.params, [[0.5, 0.5, 0.5, 0], [0.9, 0.9, 0.9, 0.2], [1, 1, 1, 0]])
+
+
+def test_material_keys_come_from_the_bsdf_modules(tmp_path):
+    """A material's keys are its BSDF module's (pyoa.render.bsdfs): a key left
+    out takes the module's default, and the glass keys are Mitsuba's."""
+    d = minimal()
+    d["materials"] = {"white": {"type": "diffuse"}, "steel": {"type": "ggx"}, "glass": {"type": "dielectric"},
+                      "water": {"type": "dielectric", "int_ior": 1.333, "ext_ior": 1.0}}
+    sc = S.load(write(tmp_path, d))
+    assert list(sc.materials.kind) == [DIFFUSE, GGX, DIELECTRIC, DIELECTRIC]
+    np.testing.assert_array_equal(sc.materials.params[:2], [[0.5, 0.5, 0.5, 0], [1, 1, 1, 0.1]])
+    np.testing.assert_array_equal(sc.materials.params[2:, 0], [1.5046 / 1.000277, 1.333])
+    for edit, fragment in (
+            ({"int_ior": 0}, "materials.glass.int_ior: expected a number > 0, got 0"),
+            ({"ext_ior": -1.0}, "materials.glass.ext_ior: expected a number > 0, got -1"),
+            ({"int_ior": "bk7"}, "materials.glass.int_ior: expected a number > 0, got \"bk7\""),
+            ({"tint": [1, 1, 1]}, "materials.glass.tint: unknown key; valid: type, int_ior, ext_ior")):
+        bad = copy.deepcopy(d)
+        bad["materials"]["glass"].update(edit)
+        raises(tmp_path, bad, fragment)
+
+
+def test_the_glass_cornell_box_is_cornell_with_a_glass_large_box():
+    glass, cornell = S.load("cornell-glass"), S.load("cornell")
+    assert glass.triangles.tobytes() == cornell.triangles.tobytes()
+    assert glass.materials.names == cornell.materials.names + ("glass",)
+    large = glass.shape_index == 6  # the large box, the seventh shape
+    assert np.all(glass.material[large] == 3) and np.array_equal(glass.material[~large], cornell.material[~large])
+    assert glass.materials.kind[3] == DIELECTRIC and glass.materials.params[3, 0] == 1.5046 / 1.000277
+    assert (glass.max_depth, glass.mis, glass.width, glass.height) == (5, True, 256, 256)
 
 
 def test_unknown_material(tmp_path):
@@ -322,7 +354,7 @@ def test_unknown_material(tmp_path):
     ("no shapes", lambda d: d.update(shapes=[]), ["shapes: no shapes"]),
     ("shapes not list", lambda d: d.update(shapes={}), ["shapes: expected a list"]),
     ("material type", lambda d: d["materials"]["white"].update(type="plastic"),
-     ["materials.white.type: unknown material type \"plastic\"; valid: diffuse, ggx, mirror"]),
+     ["materials.white.type: unknown material type \"plastic\"; valid: dielectric, diffuse, ggx, mirror"]),
     ("material no type", lambda d: d["materials"]["white"].pop("type"), ["materials.white.type: missing"]),
     ("material key", lambda d: d["materials"]["white"].update(roughness=0.1),
      ["materials.white.roughness: unknown key; valid: type, reflectance"]),

@@ -1,12 +1,17 @@
 """The path tracer's shading compiled with numba, Embree called from it.
 
 It mirrors the NumPy reference (:mod:`pyoa.render.integrator`,
-:mod:`pyoa.render.bsdf`, :mod:`pyoa.render.geometry`) function by function,
+:mod:`pyoa.render.bsdfs`, :mod:`pyoa.render.geometry`) function by function,
 the same operations in the same order, shades a bounce in vectorized loops
 over lanes (:mod:`~pyoa.render.compiled.shading`) and traces through
 :mod:`pyoa.render.embree`. Chosen with
 ``shading="numba"`` (the default), ``pyoa render --shading`` or
 ``PYOA_SHADING``.
+
+The BSDFs' one-point forms and the warps they share are plain Python in
+:mod:`pyoa.render.bsdfs` (marked :func:`pyoa.render.bsdfs.base.scalar`), so
+that a scene loads without numba; :mod:`~pyoa.render.compiled.forms` gives
+each a compiled twin, inlined into the loops that call it.
 
 numba's on-disk cache (``cache=True``) knows a compiled function only by its
 own source file: code and constants it compiled in from other files (the
@@ -14,72 +19,14 @@ BSDFs, the warps, Embree's queries, the offset constants) would be reused
 unchanged after those files change, as after a ``git pull`` into an editable
 install. So the modules of this package are imported with numba's cache
 directory set to a folder named after a digest of every source they compile
-from (:data:`SOURCES`, :func:`cache_dir`): a changed source compiles again
-instead of rendering with the old code.
+from (:data:`SOURCES`, :func:`cache_dir`, in
+:mod:`~pyoa.render.compiled.cache`): a changed source compiles again instead
+of rendering with the old code.
 """
 
 from __future__ import annotations
 
-import contextlib
-import hashlib
-import os
-from pathlib import Path
+from .cache import SOURCES, cache_dir, salted_cache, sources_digest  # noqa: F401  (this package's cache)
 
-_PYOA = Path(__file__).resolve().parent.parent.parent
-#: Files (relative to the ``pyoa`` package) whose code or constants the
-#: compiled functions contain: this package, every module of ``pyoa.render``
-#: that it imports and the numba hashes it calls (:mod:`pyoa._numba`)
-#: (``tests/render/test_compiled.py`` checks the list against the imports).
-SOURCES = tuple(f"render/{name}" for name in (
-    "compiled/__init__.py", "compiled/bsdf.py", "compiled/camera.py", "compiled/emitters.py", "compiled/geometry.py",
-    "compiled/integrator.py", "compiled/shading.py", "bsdf.py", "camera.py", "embree.py", "emitters.py",
-    "integrator.py")) + ("_numba/__init__.py", "_numba/hashes.py")
-
-
-def sources_digest(root: Path = _PYOA) -> str:
-    """SHA-256 of the names and bytes of :data:`SOURCES` under ``root``."""
-    h = hashlib.sha256()
-    for rel in SOURCES:
-        h.update(rel.encode() + b"\0")
-        h.update((root / rel).read_bytes())
-    return h.hexdigest()
-
-
-def cache_dir() -> str:
-    """numba's cache folder for this package's functions: ``pyoa-render-`` and
-    the first 16 hex digits of :func:`sources_digest`, under
-    ``$NUMBA_CACHE_DIR`` when it is set, else under ``__pycache__`` beside
-    these sources when that is writable, else under numba's user-wide cache
-    folder (the places numba itself would choose, in that order)."""
-    from numba.core import config
-
-    base = config.CACHE_DIR
-    if not base:
-        here = Path(__file__).resolve().parent
-        pycache = here / "__pycache__"
-        if os.access(pycache if pycache.is_dir() else here, os.W_OK):
-            base = str(pycache)
-        else:
-            from numba.misc.appdirs import AppDirs
-
-            base = AppDirs(appname="numba", appauthor=False).user_cache_dir
-    return os.path.join(base, f"pyoa-render-{sources_digest()[:16]}")
-
-
-@contextlib.contextmanager
-def _salted_cache():
-    """numba's cache folder set to :func:`cache_dir` while the functions of this
-    package are decorated (numba picks a function's folder then), and restored
-    after, so that no other numba user in the process is affected."""
-    from numba.core import config
-
-    old = config.CACHE_DIR
-    config.CACHE_DIR = cache_dir()
-    try:
-        yield
-    finally:
-        config.CACHE_DIR = old
-
-
-with _salted_cache():
-    from . import bsdf, camera, emitters, geometry, integrator, shading  # noqa: F401  (decorated here)
+with salted_cache():
+    from . import bsdfs, camera, emitters, forms, geometry, integrator, shading  # noqa: F401  (decorated here)

@@ -12,7 +12,7 @@ copies each lane's pixel column and row and its samples in, a vectorized one
 the reference's operations in the same order, so a pinhole camera's rays
 are the reference's to the bit (moving or not, either filter); a thin
 lens's disk point takes its sine and cosine from
-:func:`~pyoa.render.compiled.geometry.sin_cos` instead of NumPy's, so those
+:func:`~pyoa.render.bsdfs.warps.sin_cos` instead of NumPy's, so those
 rays are within 2 ulps of the reference's (both tested:
 ``tests/render/test_compiled.py``).
 """

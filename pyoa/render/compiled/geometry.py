@@ -1,4 +1,10 @@
-"""The warps and frames of :mod:`pyoa.render.geometry`, one point at a time, compiled."""
+"""The warps and frames of :mod:`pyoa.render.geometry`, one point at a time, compiled.
+
+The warps that the BSDFs' one-point forms share with the camera (the
+concentric disk, the polynomial sines and cosines) are written in
+:mod:`pyoa.render.bsdfs.warps`, plain Python compiled by
+:mod:`pyoa.render.compiled.forms`.
+"""
 
 from __future__ import annotations
 
@@ -6,66 +12,15 @@ import math
 
 from numba import njit
 
+from ..bsdfs import warps
+from .forms import compiled
+
 #: error_model="numpy": divisions follow IEEE (as the NumPy reference's do)
 #: instead of numba's default per-division ZeroDivisionError check.
 _JIT = dict(nogil=True, cache=True, inline="always", error_model="numpy")
 
-
-#: Taylor coefficients (-1)^k / (2k+1)! and (-1)^k / (2k)! of sin and cos,
-#: to x^17 and x^18: on |x| <= pi/4 the first term left out is below 6e-17
-#: of the result (half an ulp is 1.1e-16).
-_SIN = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(9))
-_COS = tuple((-1) ** k / math.factorial(2 * k) for k in range(10))
-
-
-@njit(**_JIT)
-def sin_cos(x):
-    """``(sin x, cos x)`` for ``|x| <= pi/4``, as polynomials (Horner's
-    scheme, within 2 ulps of libm's): the warps' angles all reduce to this
-    range, and libm's ``sin`` and ``cos`` (about 18 ns each, one lane at a
-    time) were most of a diffuse bounce's cost (docs/performance.md)."""
-    z = x * x
-    s = _SIN[8]
-    for k in range(7, -1, -1):
-        s = s * z + _SIN[k]
-    c = _COS[9]
-    for k in range(8, -1, -1):
-        c = c * z + _COS[k]
-    return x * s, c
-
-
-@njit(**_JIT)
-def cos_sin_turn(u):
-    """``(cos 2 pi u, sin 2 pi u)`` for ``u`` in ``[0, 1]``: the nearest
-    quarter turn ``k / 4`` is exact, the rest ``2 pi (u - k / 4)`` lies in
-    ``[-pi/4, pi/4]`` (:func:`sin_cos`), and the quarter turns swap and
-    negate. Written with selects, the quarter ``q = k mod 4`` kept a float
-    (exact for whole numbers), so that a loop over lanes vectorizes (AVX2
-    has no packed conversion of doubles to 64-bit integers)."""
-    k = math.floor(4.0 * u + 0.5)
-    s, c = sin_cos(2.0 * math.pi * (u - 0.25 * k))
-    q = k - 4.0 * math.floor(0.25 * k)
-    cq = c if q == 0.0 else (-s if q == 1.0 else (-c if q == 2.0 else s))
-    sq = s if q == 0.0 else (c if q == 1.0 else (-s if q == 2.0 else -c))
-    return cq, sq
-
-
-@njit(**_JIT)
-def concentric_disk(u0, u1):
-    """Shirley and Chiu's concentric map of ``[0,1)^2`` onto the unit disk
-    (the angle ``pi/2 - t`` of the second wedge as ``cos`` and ``sin`` of
-    ``t`` swapped), written with selects instead of branches so that a loop
-    over lanes vectorizes: the wedge picks the operands, each lane does the
-    same operations as the branching form, so the same bits."""
-    a = 2.0 * u0 - 1.0
-    b = 2.0 * u1 - 1.0
-    wide = abs(a) > abs(b)
-    r = a if wide else b
-    s, c = sin_cos((math.pi / 4) * ((b if wide else a) / r))
-    x = r * (c if wide else s)
-    y = r * (s if wide else c)
-    centre = (a == 0.0) & (b == 0.0)
-    return 0.0 if centre else x, 0.0 if centre else y
+#: Shirley and Chiu's concentric disk (:func:`pyoa.render.bsdfs.warps.concentric_disk`), the thin lens's.
+concentric_disk = compiled(warps.concentric_disk)
 
 
 @njit(**_JIT)

@@ -40,8 +40,10 @@ from numba.extending import intrinsic
 from ..._numba.hashes import hash_pair
 from .. import embree
 from .. import integrator as reference
+from ..bsdfs import BSDFS
 from ..camera import filter_offsets
 from ..integrator import RR_KEY, Stats
+from .cache import cache_dir
 from .camera import SCRATCH as CAMERA_SCRATCH
 from .camera import camera_rays
 from .shading import CHUNK, SCRATCH, hit_data, shade
@@ -68,6 +70,7 @@ class SceneData(NamedTuple):
     reach: np.ndarray  # (T,) triangle_reach: Embree's error grows with it ...
     growth: np.ndarray  # (T,) ... and, at a shadow segment's end, with its length times this
     hit_data: np.ndarray  # (T, HIT_FIELDS) what the shading reads of a hit triangle (shading.hit_data)
+    kinds: np.ndarray  # (K,) bool per BSDF kind (pyoa.render.bsdfs.KINDS): a triangle's material has it
 
 
 class CameraData(NamedTuple):
@@ -301,7 +304,8 @@ class CompiledIntegrator:
         self._scene = SceneData(
             verts=c(scene.triangles, dtype=np.float64), normals=c(scene.normals), areas=c(scene.areas),
             emission=c(scene.emission), em=c(em.index, dtype=np.int64), em_cdf=c(em.cdf), em_prob=c(em.prob),
-            reach=c(reach), growth=c(growth), hit_data=hit_data(scene, em.prob, reach))
+            reach=c(reach), growth=c(growth), hit_data=hit_data(scene, em.prob, reach),
+            kinds=np.isin(np.arange(len(BSDFS)), np.asarray(scene.materials.kind)[np.asarray(scene.material)]))
         cam = PerspectiveCamera(scene.camera, width, height)
         self._camera = CameraData(width, height, cam.tan_x, cam.tan_y, c(cam.rot), c(cam.pos), cam.aperture,
                                   cam.focus_distance, c(cam.motion))
@@ -324,8 +328,6 @@ class CompiledIntegrator:
         """Whether numba's on-disk cache holds no compiled :func:`render_paths` for these sources
         (:func:`pyoa.render.compiled.cache_dir`): the first render after an install or an update
         then compiles the renderer (15-60 s) before its first path."""
-        from . import cache_dir
-
         return not any(Path(cache_dir()).glob("*/integrator.render_paths-*.nbi"))
 
     def radiance(self, pixel, sample_index, x, seed: int = 0):

@@ -12,11 +12,12 @@ For each chunk it
    the offset of new rays for all those lanes at once (:func:`head`);
 3. adds the emission to the paths' radiance and chooses each lane's point on
    an emitter (:func:`emit_and_choose`: a binary search per lane, scalar);
-4. computes the next-event directions and the Lambertian values
-   (:func:`light_directions`) and samples the Lambertian and mirror lobes
-   (:func:`sample_lobes`) for every lane, then both again for the GGX lanes,
-   packed into rows of their own (:func:`other_kinds`, :func:`ggx_evaluate`,
-   :func:`ggx_sample`);
+4. computes the next-event directions and the first kind's (Lambertian)
+   values (:func:`light_directions`) and samples it (:func:`sample_lobes`)
+   for every lane, then both again for the lanes of every other kind the
+   scene has (:func:`other_kinds`): packed into rows of their own and shaded
+   in vectorized loops for a kind with a lane form, one lane at a time
+   otherwise;
 5. makes the shadow rays and what they carry (:func:`shadow_rays`) and
    compacts them for Embree (:func:`emit_shadows`);
 6. makes the new rays (:func:`new_rays`), and plays Russian roulette while
@@ -28,8 +29,8 @@ sample or new ray follows) only adds the emission its rays see:
 :func:`emission_only` does that one entry at a time for the few rays that
 hit an emitter's front, without the scratch.
 
-The lane loops of steps 2, 4, 5 and 6 (all but the packing of GGX lanes,
-the per-point fallback for other kinds and the compactions) contain no
+The lane loops of steps 2, 4, 5 and 6 (all but the packing of a kind's
+lanes, the kinds shaded one lane at a time and the compactions) contain no
 branches that depend on a lane (selects instead)
 and touch only the scratch, laid out as one flat array
 with rows :data:`CHUNK` apart: with the distance between rows a compile-time
@@ -50,10 +51,10 @@ import numpy as np
 from numba import njit
 
 from ..._numba.hashes import hash_pair
-from ..bsdf import DIFFUSE, GGX, MIRROR
+from .. import bsdfs
 from ..integrator import ORIGIN_ERROR, RR_KEY, TEST_ERROR
-from .bsdf import evaluate, evaluate_diffuse, evaluate_ggx, sample, sample_diffuse, sample_ggx
 from .emitters import sample_emitter
+from .forms import compiled
 from .geometry import frame
 
 #: error_model="numpy": IEEE divisions, as the NumPy reference's (numba's
@@ -63,7 +64,7 @@ _JIT = dict(nogil=True, cache=True, error_model="numpy")
 _INLINE = dict(_JIT, inline="always")
 
 #: Lanes shaded together: the rows of the scratch array. 256 lanes of its
-#: 129 rows are 266 KiB, within a core's L2 cache.
+#: 133 rows are 274 KiB, within a core's L2 cache.
 CHUNK = 256
 #: Distance between the scratch's rows: CHUNK plus one cache line, because rows a
 #: power of two apart fall into the same few sets of the L1 cache and evict
@@ -72,11 +73,13 @@ ROW = CHUNK + 8
 
 #: The scratch's rows (each ``CHUNK`` float64 values; flags and material
 #: kinds are stored as 0.0/1.0 and small whole numbers). Inputs, copied by
-#: :func:`gather`:
-(DX, DY, DZ, OX, OY, OZ, T, V0X, V0Y, V0Z, NX, NY, NZ, ER, EG, EB, PDF_AREA_HIT, REACH, KIND, ALPHA, CR, CG, CB,
+#: :func:`gather` (the material: its BSDF's kind, whether that is smooth, so
+#: gets a light sample, and its numbers ``M0 .. M3``, ``Materials.params``):
+(DX, DY, DZ, OX, OY, OZ, T, V0X, V0Y, V0Z, NX, NY, NZ, ER, EG, EB, PDF_AREA_HIT, REACH, KIND, SMOOTH, M0, M1, M2, M3,
  BR, BG, BB, PREV_PDF, PREV_DELTA, LIGHT_U, LIGHT_V, BSDF_U, BSDF_V,
- # the hit (head): point, shading normal, tangents, outgoing direction (local), offset, emission seen
- PX, PY, PZ, SX, SY, SZ, TX, TY, TZ, BX, BY, BZ, WOX, WOY, WOZ, EPS, SEEN, LE_R, LE_G, LE_B,
+ # the hit (head): point, shading normal, tangents, outgoing direction (local), whether it came from the side of
+ # the geometric normal, offset, emission seen
+ PX, PY, PZ, SX, SY, SZ, TX, TY, TZ, BX, BY, BZ, WOX, WOY, WOZ, FRONT, EPS, SEEN, LE_R, LE_G, LE_B,
  # the point chosen on an emitter (emit_and_choose)
  QX, QY, QZ, MX, MY, MZ, PDF_AREA, QE_R, QE_G, QE_B, Q_GROWTH, Q_REACH,
  # next event: direction to the light, its cosine there, local direction, BSDF value and pdf
@@ -85,14 +88,16 @@ ROW = CHUNK + 8
  SH_OK, SH_OX, SH_OY, SH_OZ, SH_DX, SH_DY, SH_DZ, SH_SEG, SH_R, SH_G, SH_B,
  # the BSDF sample (local direction, weight, pdf, delta) and the new ray
  NIX, NIY, NIZ, WR, WG, WB, PDF, DELTA, ALIVE, NBR, NBG, NBB, NOX, NOY, NOZ, NDX, NDY, NDZ,
- # the GGX lanes, packed to the front (other_kinds): which lane, what their BSDF reads, what it gives
- G_K, G_CR, G_CG, G_CB, G_ALPHA, G_OX, G_OY, G_OZ, G_IX, G_IY, G_IZ, G_U, G_V,
- G_FR, G_FG, G_FB, G_PDF_B, G_NIX, G_NIY, G_NIZ, G_WR, G_WG, G_WB, G_PDF) = (k * ROW for k in range(129))
+ # the lanes of one kind with a lane form, packed to the front (other_kinds): which lane, what its BSDF reads,
+ # what it gives
+ PK_LANE, PK_M0, PK_M1, PK_M2, PK_M3, PK_FRONT, PK_OX, PK_OY, PK_OZ, PK_IX, PK_IY, PK_IZ, PK_U, PK_V,
+ PK_FR, PK_FG, PK_FB, PK_PDF_B, PK_NIX, PK_NIY, PK_NIZ, PK_WR, PK_WG, PK_WB, PK_PDF, PK_DELTA) = (
+    k * ROW for k in range(133))
 #: Length of the scratch array: one ROW past the last row.
-SCRATCH = G_PDF + ROW
+SCRATCH = PK_DELTA + ROW
 #: The per-triangle values :func:`gather` copies, in the order of the rows
-#: ``V0X .. CB`` (:func:`hit_data` makes them).
-HIT_FIELDS = 16
+#: ``V0X .. M3`` (:func:`hit_data` makes them).
+HIT_FIELDS = 17
 
 
 def hit_data(scene, em_prob, reach):
@@ -103,12 +108,14 @@ def hit_data(scene, em_prob, reach):
     (``em_prob / area``, the reference's first operation on the two, so the
     same bits; ``em_prob``: :attr:`pyoa.render.emitters.Emitters.prob`), its
     offset scale (``reach``: :func:`pyoa.render.integrator.triangle_reach`),
-    and its material's kind, roughness and colour."""
+    and its material's kind, whether that is smooth (not a delta) and its
+    numbers (``Materials.params``)."""
     mat, m = np.asarray(scene.material), scene.materials
+    kind = np.asarray(m.kind)[mat]
     return np.ascontiguousarray(np.column_stack([
         np.asarray(scene.triangles, np.float64)[:, 0], scene.normals, scene.emission,
-        np.asarray(em_prob) / np.asarray(scene.areas), reach, np.asarray(m.kind, np.float64)[mat],
-        np.asarray(m.alpha)[mat], np.asarray(m.color)[mat]]), dtype=np.float64)
+        np.asarray(em_prob) / np.asarray(scene.areas), reach, kind.astype(np.float64),
+        (~bsdfs.DELTA[kind]).astype(np.float64), np.asarray(m.params)[mat]]), dtype=np.float64)
 
 
 @njit(**_INLINE)
@@ -192,7 +199,7 @@ def gather(start, stop, depth, sc, ps, x, w, F, lanes):
         F[DX + h], F[DY + h], F[DZ + h] = w.d[i, 0], w.d[i, 1], w.d[i, 2]
         F[OX + h], F[OY + h], F[OZ + h] = w.o[i, 0], w.o[i, 1], w.o[i, 2]
         F[T + h] = w.t[i]
-        for c in range(HIT_FIELDS):  # the triangle's row of sc.hit_data: V0X .. CB
+        for c in range(HIT_FIELDS):  # the triangle's row of sc.hit_data: V0X .. M3
             F[V0X + c * ROW + h] = sc.hit_data[tri, c]
         br, bg, bb, prev_pdf, prev_delta = path_state(w, i, depth)
         F[BR + h], F[BG + h], F[BB + h] = br, bg, bb
@@ -212,7 +219,8 @@ def head(h, depth, mis, F):
     its triangle's plane (:func:`to_plane`), the emission the ray sees with
     its MIS weight (emitters are one-sided), how far new rays leave the
     point (:func:`offset_distance`), the shading frame facing the incoming
-    ray (two-sided surfaces) and the outgoing direction in it."""
+    ray (two-sided surfaces), the outgoing direction in it and whether the
+    ray came from the side the geometric normal points to (``FRONT``)."""
     for k in range(h):
         dx, dy, dz = F[DX + k], F[DY + k], F[DZ + k]
         nx, ny, nz = F[NX + k], F[NY + k], F[NZ + k]
@@ -237,21 +245,22 @@ def head(h, depth, mis, F):
         F[WOX + k] = -(dx * tx + dy * ty + dz * tz)
         F[WOY + k] = -(dx * bx + dy * by + dz * bz)
         F[WOZ + k] = max(-(dx * sx + dy * sy + dz * sz), 1e-9)
+        F[FRONT + k] = 0.0 if back else 1.0
 
 
 @njit(**_JIT)
 def emit_and_choose(h, sc, F, lanes, radiance):
     """Add the emission each lane's ray sees to its path's radiance and
-    choose a point on an emitter by power for each lane whose BSDF is not a
-    mirror (:func:`sample_emitter`, a binary search). (The last bounce has
-    no light sample: :func:`emission_only`.)"""
+    choose a point on an emitter by power for each lane whose BSDF is smooth
+    (not a delta; :func:`sample_emitter`, a binary search). (The last bounce
+    has no light sample: :func:`emission_only`.)"""
     for k in range(h):
         li = lanes[k]
         if F[SEEN + k] != 0.0:
             radiance[li, 0] += F[LE_R + k]
             radiance[li, 1] += F[LE_G + k]
             radiance[li, 2] += F[LE_B + k]
-        if F[KIND + k] != MIRROR:
+        if F[SMOOTH + k] != 0.0:
             etri, qx, qy, qz, mx, my, mz, pdf_area = sample_emitter(
                 sc.em, sc.em_cdf, sc.em_prob, sc.verts, sc.normals, sc.areas, F[LIGHT_U + k], F[LIGHT_V + k])
             F[QX + k], F[QY + k], F[QZ + k] = qx, qy, qz
@@ -267,11 +276,20 @@ def emit_and_choose(h, sc, F, lanes, radiance):
             F[QE_R + k], F[QE_G + k], F[QE_B + k] = 0.0, 0.0, 0.0
 
 
+#: The registry's first kind (the Lambertian), whose one-point forms
+#: :func:`light_directions` and :func:`sample_lobes` run on every lane (most
+#: surfaces of most scenes are of that kind; :func:`other_kinds` overwrites
+#: the lanes of the others). Its forms must be free of branches.
+_BASE = bsdfs.BSDFS[0]
+_base_evaluate, _base_sample = compiled(_BASE.evaluate_point), compiled(_BASE.sample_point)
+_BASE_DELTA = bool(_BASE.DELTA)
+
+
 @njit(**_JIT)
 def light_directions(h, F):
     """For each lane (vectorized): the unit direction ``w`` to its point on an
     emitter, the distance, the cosine there, ``w`` in the shading frame and
-    the Lambertian ``(f_cos, pdf)`` of it (the other BSDFs:
+    the first kind's ``(f_cos, pdf)`` of it (the other kinds:
     :func:`other_kinds`)."""
     for k in range(h):
         px, py, pz = F[PX + k], F[PY + k], F[PZ + k]
@@ -279,88 +297,185 @@ def light_directions(h, F):
         dist = math.sqrt(vx * vx + vy * vy + vz * vz)
         inv = 1.0 / max(dist, 1e-12)  # one division, three products (the reference divides thrice)
         wx, wy, wz = vx * inv, vy * inv, vz * inv
+        ix = wx * F[TX + k] + wy * F[TY + k] + wz * F[TZ + k]
+        iy = wx * F[BX + k] + wy * F[BY + k] + wz * F[BZ + k]
         iz = wx * F[SX + k] + wy * F[SY + k] + wz * F[SZ + k]
         F[DIST + k] = dist
         F[WX + k], F[WY + k], F[WZ + k] = wx, wy, wz
         F[COS_Q + k] = -(F[MX + k] * wx + F[MY + k] * wy + F[MZ + k] * wz)
-        F[IX + k] = wx * F[TX + k] + wy * F[TY + k] + wz * F[TZ + k]
-        F[IY + k] = wx * F[BX + k] + wy * F[BY + k] + wz * F[BZ + k]
-        F[IZ + k] = iz
-        F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = evaluate_diffuse(F[CR + k], F[CG + k], F[CB + k],
-                                                                        F[WOZ + k], iz)
+        F[IX + k], F[IY + k], F[IZ + k] = ix, iy, iz
+        F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = _base_evaluate(
+            F[M0 + k], F[M1 + k], F[M2 + k], F[M3 + k], F[FRONT + k] != 0.0, F[WOX + k], F[WOY + k], F[WOZ + k],
+            ix, iy, iz)
 
 
 @njit(**_JIT)
-def ggx_evaluate(g, F):
-    """The next-event ``(f_cos, pdf)`` of the ``g`` packed GGX lanes
-    (vectorized; :func:`~pyoa.render.compiled.bsdf.evaluate_ggx`)."""
-    for j in range(g):
-        F[G_FR + j], F[G_FG + j], F[G_FB + j], F[G_PDF_B + j] = evaluate_ggx(
-            F[G_CR + j], F[G_CG + j], F[G_CB + j], F[G_ALPHA + j], F[G_OX + j], F[G_OY + j], F[G_OZ + j],
-            F[G_IX + j], F[G_IY + j], F[G_IZ + j])
+def sample_lobes(h, F):
+    """The first kind's BSDF sample of each lane (vectorized; where ``wo``
+    lies below the surface: ``wi = +z``, weight and pdf 0, as
+    :func:`~pyoa.render.compiled.bsdfs.sample`); the other kinds:
+    :func:`other_kinds`."""
+    for k in range(h):
+        ox, oy, oz = F[WOX + k], F[WOY + k], F[WOZ + k]
+        x, y, z, wr, wg, wb, pdf, delta = _base_sample(F[M0 + k], F[M1 + k], F[M2 + k], F[M3 + k],
+                                                       F[FRONT + k] != 0.0, ox, oy, oz, F[BSDF_U + k], F[BSDF_V + k])
+        below = oz <= 0.0  # the frame faces the ray, so it does not happen
+        F[NIX + k] = 0.0 if below else x
+        F[NIY + k] = 0.0 if below else y
+        F[NIZ + k] = 1.0 if below else z
+        F[WR + k] = 0.0 if below else wr
+        F[WG + k] = 0.0 if below else wg
+        F[WB + k] = 0.0 if below else wb
+        F[PDF + k] = 0.0 if below else pdf
+        F[DELTA + k] = 1.0 if (_BASE_DELTA if below else delta) else 0.0
 
 
 @njit(**_JIT)
-def ggx_sample(g, F):
-    """The BSDF sample of the ``g`` packed GGX lanes (vectorized;
-    :func:`~pyoa.render.compiled.bsdf.sample_ggx`)."""
-    for j in range(g):
-        (F[G_NIX + j], F[G_NIY + j], F[G_NIZ + j], F[G_WR + j], F[G_WG + j], F[G_WB + j],
-         F[G_PDF + j]) = sample_ggx(F[G_CR + j], F[G_CG + j], F[G_CB + j], F[G_ALPHA + j], F[G_OX + j],
-                                    F[G_OY + j], F[G_OZ + j], F[G_U + j], F[G_V + j])
-
-
-@njit(**_JIT)
-def other_kinds(h, extend, F):
-    """The next-event ``(f_cos, pdf)`` and (``extend``) the BSDF sample of the
-    lanes whose BSDF is neither Lambertian nor a mirror, written over what
-    :func:`light_directions` and :func:`sample_lobes` wrote for them.
-
-    GGX lanes: their arithmetic is long and they are few (``deep`` and
-    ``dof7d``: one box of steel), so their inputs are packed to the front of
-    rows of their own (scalar), shaded there in vectorized loops
-    (:func:`ggx_evaluate`, :func:`ggx_sample`) and copied back (scalar):
-    about half the time of shading them one at a time (``deep``,
-    docs/performance.md). Where ``wo`` lies below the surface the sample is
-    :func:`sample_lobes`' (as :func:`~pyoa.render.compiled.bsdf.sample`'s);
-    a GGX sample is never a delta. So when ``extend``, :func:`sample_lobes`
-    must have run on the chunk first (:func:`shade` runs it just before).
-    A kind with no lane form (a new BSDF,
-    until it gets one) is shaded one lane at a time by the per-point
-    :func:`~pyoa.render.compiled.bsdf.evaluate` and
-    :func:`~pyoa.render.compiled.bsdf.sample`."""
+def pack(h, kind, F):
+    """Copy what the BSDF reads of the lanes of kind ``kind`` to the front of
+    the packed rows (``PK_*``, their lane in ``PK_LANE``); returns how many."""
     g = 0
     for k in range(h):
-        kind = F[KIND + k]
-        if kind == GGX:
-            F[G_K + g] = k
-            F[G_CR + g], F[G_CG + g], F[G_CB + g], F[G_ALPHA + g] = F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k]
-            F[G_OX + g], F[G_OY + g], F[G_OZ + g] = F[WOX + k], F[WOY + k], F[WOZ + k]
-            F[G_IX + g], F[G_IY + g], F[G_IZ + g] = F[IX + k], F[IY + k], F[IZ + k]
-            F[G_U + g], F[G_V + g] = F[BSDF_U + k], F[BSDF_V + k]
+        if F[KIND + k] == kind:
+            F[PK_LANE + g] = k
+            F[PK_M0 + g], F[PK_M1 + g], F[PK_M2 + g], F[PK_M3 + g] = F[M0 + k], F[M1 + k], F[M2 + k], F[M3 + k]
+            F[PK_FRONT + g] = F[FRONT + k]
+            F[PK_OX + g], F[PK_OY + g], F[PK_OZ + g] = F[WOX + k], F[WOY + k], F[WOZ + k]
+            F[PK_IX + g], F[PK_IY + g], F[PK_IZ + g] = F[IX + k], F[IY + k], F[IZ + k]
+            F[PK_U + g], F[PK_V + g] = F[BSDF_U + k], F[BSDF_V + k]
             g += 1
-        elif kind != DIFFUSE and kind != MIRROR:
-            F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = evaluate(
-                np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k], F[WOZ + k],
-                F[IX + k], F[IY + k], F[IZ + k])
-            if extend:
-                ix, iy, iz, wr, wg, wb, pdf, delta = sample(
-                    np.int64(kind), F[CR + k], F[CG + k], F[CB + k], F[ALPHA + k], F[WOX + k], F[WOY + k],
-                    F[WOZ + k], F[BSDF_U + k], F[BSDF_V + k])
-                F[NIX + k], F[NIY + k], F[NIZ + k] = ix, iy, iz
-                F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = wr, wg, wb, pdf
-                F[DELTA + k] = 1.0 if delta else 0.0
-    if g == 0:
-        return
-    ggx_evaluate(g, F)
-    if extend:
-        ggx_sample(g, F)
+    return g
+
+
+@njit(**_JIT)
+def unpack(g, extend, F):
+    """Copy the packed lanes' next-event values and (``extend``) samples back
+    to their lanes' rows."""
     for j in range(g):
-        k = np.int64(F[G_K + j])
-        F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = F[G_FR + j], F[G_FG + j], F[G_FB + j], F[G_PDF_B + j]
-        if extend and not F[G_OZ + j] <= 0.0:  # as sample's test, NaN included
-            F[NIX + k], F[NIY + k], F[NIZ + k] = F[G_NIX + j], F[G_NIY + j], F[G_NIZ + j]
-            F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = F[G_WR + j], F[G_WG + j], F[G_WB + j], F[G_PDF + j]
+        k = np.int64(F[PK_LANE + j])
+        F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = F[PK_FR + j], F[PK_FG + j], F[PK_FB + j], F[PK_PDF_B + j]
+        if extend:
+            F[NIX + k], F[NIY + k], F[NIZ + k] = F[PK_NIX + j], F[PK_NIY + j], F[PK_NIZ + j]
+            F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = F[PK_WR + j], F[PK_WG + j], F[PK_WB + j], F[PK_PDF + j]
+            F[DELTA + k] = F[PK_DELTA + j]
+
+
+def lane_loops(module):
+    """A BSDF's lane form: ``(evaluate, sample)``, vectorized loops over the
+    ``g`` packed lanes (:func:`pack`) that call its one-point forms (which
+    must be free of branches), the sample with the guard of
+    :func:`sample_lobes`."""
+    evaluate_point, sample_point = compiled(module.evaluate_point), compiled(module.sample_point)
+    delta_below = bool(module.DELTA)
+
+    def evaluate(g, F):
+        for j in range(g):
+            F[PK_FR + j], F[PK_FG + j], F[PK_FB + j], F[PK_PDF_B + j] = evaluate_point(
+                F[PK_M0 + j], F[PK_M1 + j], F[PK_M2 + j], F[PK_M3 + j], F[PK_FRONT + j] != 0.0, F[PK_OX + j],
+                F[PK_OY + j], F[PK_OZ + j], F[PK_IX + j], F[PK_IY + j], F[PK_IZ + j])
+
+    def sample(g, F):
+        for j in range(g):
+            oz = F[PK_OZ + j]
+            x, y, z, wr, wg, wb, pdf, delta = sample_point(
+                F[PK_M0 + j], F[PK_M1 + j], F[PK_M2 + j], F[PK_M3 + j], F[PK_FRONT + j] != 0.0, F[PK_OX + j],
+                F[PK_OY + j], oz, F[PK_U + j], F[PK_V + j])
+            below = oz <= 0.0
+            F[PK_NIX + j] = 0.0 if below else x
+            F[PK_NIY + j] = 0.0 if below else y
+            F[PK_NIZ + j] = 1.0 if below else z
+            F[PK_WR + j] = 0.0 if below else wr
+            F[PK_WG + j] = 0.0 if below else wg
+            F[PK_WB + j] = 0.0 if below else wb
+            F[PK_PDF + j] = 0.0 if below else pdf
+            F[PK_DELTA + j] = 1.0 if (delta_below if below else delta) else 0.0
+
+    return njit(**_JIT)(evaluate), njit(**_JIT)(sample)
+
+
+def _kind_pass(kind, module, rest):
+    """The shading of the lanes of one kind other than the first, then
+    ``rest``'s: skipped unless the scene has that kind (``kinds[kind]``); its
+    lanes packed and shaded by its lane form when it has one (``LANES``), else
+    one lane at a time by its one-point forms."""
+    if module.LANES:
+        evaluate_lanes, sample_lanes = LANE_LOOPS[kind] = lane_loops(module)
+
+        def shade_kind(h, extend, kinds, F):
+            if kinds[kind]:
+                g = pack(h, kind, F)
+                if g > 0:
+                    evaluate_lanes(g, F)
+                    if extend:
+                        sample_lanes(g, F)
+                    unpack(g, extend, F)
+            rest(h, extend, kinds, F)
+    else:
+        evaluate_point, sample_point = compiled(module.evaluate_point), compiled(module.sample_point)
+        delta_below = bool(module.DELTA)
+
+        def shade_kind(h, extend, kinds, F):
+            if kinds[kind]:
+                for k in range(h):
+                    if F[KIND + k] != kind:
+                        continue
+                    m0, m1, m2, m3, front = F[M0 + k], F[M1 + k], F[M2 + k], F[M3 + k], F[FRONT + k] != 0.0
+                    ox, oy, oz = F[WOX + k], F[WOY + k], F[WOZ + k]
+                    F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k] = evaluate_point(
+                        m0, m1, m2, m3, front, ox, oy, oz, F[IX + k], F[IY + k], F[IZ + k])
+                    if not extend:
+                        continue
+                    if oz <= 0.0:  # as compiled.bsdfs.sample
+                        F[NIX + k], F[NIY + k], F[NIZ + k] = 0.0, 0.0, 1.0
+                        F[WR + k], F[WG + k], F[WB + k], F[PDF + k] = 0.0, 0.0, 0.0, 0.0
+                        F[DELTA + k] = 1.0 if delta_below else 0.0
+                        continue
+                    x, y, z, wr, wg, wb, pdf, delta = sample_point(m0, m1, m2, m3, front, ox, oy, oz, F[BSDF_U + k],
+                                                                   F[BSDF_V + k])
+                    F[NIX + k], F[NIY + k], F[NIZ + k], F[WR + k], F[WG + k], F[WB + k] = x, y, z, wr, wg, wb
+                    F[PDF + k], F[DELTA + k] = pdf, 1.0 if delta else 0.0
+            rest(h, extend, kinds, F)
+
+    return njit(**_JIT)(shade_kind)
+
+
+@njit(**_JIT)
+def _no_kind(h, extend, kinds, F):
+    return None
+
+
+def _kind_passes():
+    """One :func:`_kind_pass` per kind of the registry after the first, chained in kind order."""
+    link = _no_kind
+    for kind in range(len(bsdfs.BSDFS) - 1, 0, -1):
+        link = _kind_pass(kind, bsdfs.BSDFS[kind], link)
+    return link
+
+
+#: The lane form (:func:`lane_loops`) of each kind that has one, by kind id:
+#: those :func:`other_kinds` runs (filled by :func:`_kind_pass`).
+LANE_LOOPS: dict = {}
+_other_kinds = _kind_passes()
+
+
+@njit(**_JIT)
+def other_kinds(h, extend, kinds, F):
+    """The next-event ``(f_cos, pdf)`` and (``extend``) the BSDF sample of the
+    lanes of every kind but the first that the scene has (``kinds``: per
+    kind id, whether a material of the scene has it), written over what
+    :func:`light_directions` and :func:`sample_lobes` wrote for them, one
+    kind after another (kind order).
+
+    A kind with a lane form (``LANES``, GGX and glass): its arithmetic is long
+    and its lanes are few (``deep`` and ``dof7d``: one box of steel), so
+    their inputs are packed to the front of rows of their own (scalar,
+    :func:`pack`), shaded there in vectorized loops (:func:`lane_loops`) and
+    copied back (scalar, :func:`unpack`): about half the time of shading
+    them one at a time (``deep``, docs/performance.md). A kind without one
+    (the mirror, a new BSDF until it gets one) is shaded one lane at a time
+    by its one-point forms. When ``extend``, :func:`sample_lobes` must have
+    run on the chunk first (:func:`shade` runs it just before)."""
+    _other_kinds(h, extend, kinds, F)
 
 
 @njit(**_JIT)
@@ -375,7 +490,7 @@ def shadow_rays(h, mis, F):
         dist, cos_q = F[DIST + k], F[COS_Q + k]
         fr, fg, fb, pdf_b = F[FR + k], F[FG + k], F[FB + k], F[PDF_B + k]
         pdf_l = F[PDF_AREA + k] * dist * dist / max(cos_q, 1e-12)
-        ok = (F[KIND + k] != MIRROR) & (cos_q > 0) & ((fr > 0) | (fg > 0) | (fb > 0))
+        ok = (F[SMOOTH + k] != 0.0) & (cos_q > 0) & ((fr > 0) | (fg > 0) | (fb > 0))
         eps = F[EPS + k]
         side = eps if F[IZ + k] > 0 else -eps
         sx, sy, sz = F[SX + k], F[SY + k], F[SZ + k]
@@ -410,27 +525,6 @@ def emit_shadows(h, F, lanes, w, shadows):
             w.sh_c[j, 0], w.sh_c[j, 1], w.sh_c[j, 2] = F[SH_R + k], F[SH_G + k], F[SH_B + k]
             shadows += 1
     return shadows
-
-
-@njit(**_JIT)
-def sample_lobes(h, F):
-    """The BSDF sample of each lane (vectorized) for the Lambertian and the
-    mirror lobes, chosen by a select (:func:`sample_diffuse`; a mirror
-    reflects ``wo``); the other kinds: :func:`other_kinds`."""
-    for k in range(h):
-        ox, oy, oz = F[WOX + k], F[WOY + k], F[WOZ + k]
-        cr, cg, cb = F[CR + k], F[CG + k], F[CB + k]
-        x, y, z, wr, wg, wb, pdf = sample_diffuse(cr, cg, cb, F[BSDF_U + k], F[BSDF_V + k])
-        mirror = F[KIND + k] == MIRROR
-        below = oz <= 0.0  # as bsdf.sample (the frame faces the ray, so it does not happen)
-        F[NIX + k] = 0.0 if below else (-ox if mirror else x)
-        F[NIY + k] = 0.0 if below else (-oy if mirror else y)
-        F[NIZ + k] = 1.0 if below else (oz if mirror else z)
-        F[WR + k] = 0.0 if below else (cr if mirror else wr)
-        F[WG + k] = 0.0 if below else (cg if mirror else wg)
-        F[WB + k] = 0.0 if below else (cb if mirror else wb)
-        F[PDF + k] = 0.0 if below else (0.0 if mirror else pdf)
-        F[DELTA + k] = 1.0 if mirror else 0.0
 
 
 @njit(**_JIT)
@@ -551,7 +645,7 @@ def shade(n, depth, sc, ps, x, sample_index, rr_key, w, radiance, F, lanes):
         light_directions(h, F)
         if extend:
             sample_lobes(h, F)
-        other_kinds(h, extend, F)
+        other_kinds(h, extend, sc.kinds, F)
         shadow_rays(h, ps.mis, F)
         shadows = emit_shadows(h, F, lanes, w, shadows)
         if extend:
