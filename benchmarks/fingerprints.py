@@ -81,9 +81,14 @@ def main(argv=None) -> int:
     if a.compare:
         with open(a.compare) as f:
             old = json.load(f)
-        diff = [f"{part}/{k}" for part in prints for k in prints[part] if old.get(part, {}).get(k) != prints[part][k]]
-        print("differ:" if diff else "all fingerprints equal", *diff)
-        return 1 if diff else 0
+        known = [(part, k) for part in prints for k in prints[part] if k in old.get(part, {})]
+        diff = [f"{part}/{k}" for part, k in known if old[part][k] != prints[part][k]]
+        new = [f"{part}/{k}" for part in prints for k in prints[part] if k not in old.get(part, {})]
+        gone = [f"{part}/{k}" for part in old for k in old[part] if k not in prints.get(part, {})]
+        print("differ:" if diff or gone else "all fingerprints equal", *diff, *(f"{g} (gone)" for g in gone))
+        if new:
+            print("new (no earlier fingerprint):", *new)
+        return 1 if diff or gone else 0
     return 0
 
 

@@ -100,6 +100,12 @@ def _mitsuba_goal() -> str:
     return mitsuba_study.goal_text(figures.load(MITSUBA / "speed.json"))
 
 
+def _glass_mitsuba() -> str:
+    import glass_mitsuba
+
+    return glass_mitsuba.table(figures.load(figures.RESULTS / "cornell-glass-mitsuba.json"))
+
+
 def _cluster_speedup() -> str:
     import bench_cluster
 
@@ -130,6 +136,9 @@ SECTIONS: dict[str, Entry] = {
     # benchmarks/bench_openqmc.py: the C headers against OpenQMC
     "openqmc": Entry((PERFORMANCE,), figures.OPENQMC, figures.openqmc_table),
     "openqmc-goal": Entry((PERFORMANCE,), figures.OPENQMC, figures.openqmc_goal, inline=True),
+    # benchmarks/glass_mitsuba.py: the glass Cornell box against Mitsuba 3
+    "glass-mitsuba": Entry((REPO / "docs" / "rendering.md",), (figures.RESULTS / "cornell-glass-mitsuba.json",),
+                           _glass_mitsuba),
     # benchmarks/bench_cluster.py: a study's speed-up on a local cluster
     "cluster-speedup": Entry((REPO / "docs" / "distributed.md",), (figures.RESULTS / "cluster.json",), _cluster_speedup),
 }
