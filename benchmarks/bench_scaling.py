@@ -80,7 +80,7 @@ run's time and the machine's description (``common.machine()``),
 values per call, pixels up to 65,536, 25 spp and 8x8-64x64 images for the
 render) for a smoke run of well under a minute, and writes to the uncommitted
 ``benchmarks/results/quick/`` and ``docs/performance/quick/`` instead. Every
-file is written atomically (``pyoa.atomic.atomic_path``).
+file is written atomically (``pyoa.util.atomic.atomic_path``).
 
 A full run takes several minutes on a 2-core machine (the NumPy backend's
 1,048,576-pixel point alone is about 25 s per call) and needs about 6 GB of
@@ -124,7 +124,7 @@ from common import MEMORY_CHILD_HELPERS, loadavg, log, machine, machine_lines, w
 
 try:
     import pyoa
-    from pyoa.atomic import atomic_path
+    from pyoa.util.atomic import atomic_path
 except ImportError as _exc:  # pragma: no cover - environment problem
     sys.exit(f"bench_scaling: cannot import pyoa ({_exc}); install it first: pip install -e .")
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import pyoa
-from pyoa.atomic import atomic_path
+from pyoa.util.atomic import atomic_path
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -39,7 +39,7 @@ def _cpu() -> dict:
     """Vendor, family, model and widest vector ISA: the same workload runs
     2.5-3.5x faster on the Zen 5 EPYC (AVX-512) than on the AVX2 EPYC of this
     machine kind, so a figure without its CPU is not comparable."""
-    from pyoa.hostcpu import host_cpu
+    from pyoa.util.hostcpu import host_cpu
 
     cpu = host_cpu()
     return {"cpu_model": cpu.name, "cpu_vendor": cpu.vendor, "cpu_family": cpu.family,

@@ -61,7 +61,7 @@ sys.path.insert(0, str(REPO / "benchmarks"))  # common.py
 
 import pyoa  # noqa: E402
 from pyoa import c_headers, catalogue  # noqa: E402
-from pyoa.catalogue_types import OFFSETS  # noqa: E402
+from pyoa.catalogue.entries import OFFSETS  # noqa: E402
 
 SOURCE = REPO / "benchmarks" / "cuda" / "values.cu"
 RESULTS = REPO / "benchmarks" / "results"

@@ -43,8 +43,8 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 import pyoa  # noqa: E402
-from pyoa.atomic import atomic_path, check_writable  # noqa: E402
-from pyoa.progressive import BASES  # noqa: E402
+from pyoa.util.atomic import atomic_path, check_writable  # noqa: E402
+from pyoa.catalogue.faure import BASES  # noqa: E402
 
 #: Colours of the two aligned blocks of the 2 b^2 panel (and of single-block panels).
 FIRST, SECOND = "#1f4e9c", "#d9480f"

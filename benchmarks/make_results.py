@@ -34,7 +34,7 @@ sys.path.insert(0, str(REPO / "benchmarks"))
 import marked  # noqa: E402
 
 from pyoa import analysis, catalogue  # noqa: E402
-from pyoa.atomic import atomic_path  # noqa: E402
+from pyoa.util.atomic import atomic_path  # noqa: E402
 from pyoa.plots import error_spectra, projections, spectrum  # noqa: E402
 
 OUT = REPO / "docs" / "results"

@@ -19,7 +19,7 @@ Only the text between a section's markers is ever replaced; the page around
 it is the author's. A missing or repeated marker is refused, never guessed
 at: a benchmark that wrote its figures "near" where a section used to be
 would put them in the wrong place silently. Pages are written through
-:func:`pyoa.atomic.atomic_path`, so an interrupted run leaves the old page.
+:func:`pyoa.util.atomic.atomic_path`, so an interrupted run leaves the old page.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from pyoa.atomic import atomic_path
+from pyoa.util.atomic import atomic_path
 
 #: Hex digits of SHA-256 kept in a marker: 64 bits, enough to tell an edit from the generated text.
 DIGEST_HEX = 16

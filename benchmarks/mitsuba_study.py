@@ -86,7 +86,7 @@ import peers
 import figures
 from common import write_csv, write_text
 
-from pyoa.atomic import atomic_path
+from pyoa.util.atomic import atomic_path
 
 OUT = REPO / "docs" / "results" / "mitsuba"
 #: The marked sections this study writes: in docs/results.md, and in docs/performance.md.
@@ -174,7 +174,7 @@ def cpu_info() -> dict:
         elif key == "Model":
             info["model"] = value
     try:
-        from pyoa.hostcpu import host_cpu
+        from pyoa.util.hostcpu import host_cpu
 
         info["isa"] = host_cpu().isa
     except Exception:  # noqa: BLE001 - only a label

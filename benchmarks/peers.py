@@ -81,7 +81,7 @@ _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 
 
 # Which libLLVM Dr.Jit should load: pyoa's own finder (Mitsuba 3.9 needs LLVM >= 16).
-from pyoa.drjit_llvm import MIN_DRJIT_LLVM, drjit_llvm  # noqa: E402,F401
+from pyoa.util.drjit_llvm import MIN_DRJIT_LLVM, drjit_llvm  # noqa: E402,F401
 
 
 def run_json_script(script: str, args: list, *, timeout: float | None = None, env: dict | None = None) -> dict:

@@ -212,7 +212,7 @@ def probe(name: str, robust: bool) -> str:
 
 
 def main(argv: list[str]) -> int:
-    from pyoa.hostcpu import host_cpu
+    from pyoa.util.hostcpu import host_cpu
 
     specs = argv or [f"{s}:F" for s in ("cornell", "dof7d", "bounce9d", "deep")]
     print(f"CPU: {host_cpu().describe()}")

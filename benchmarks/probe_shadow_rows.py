@@ -58,7 +58,7 @@ def probe(name: str, robust: bool, rounds: int) -> str:
 
 
 def main(argv: list[str]) -> int:
-    from pyoa.hostcpu import host_cpu
+    from pyoa.util.hostcpu import host_cpu
 
     rounds = 7
     if "--rounds" in argv:

@@ -16,7 +16,7 @@ from . import reference
 from .backends import PyoaFallbackWarning, backends
 from .c_headers import get_include
 from .catalogue import valid_spp
-from .catalogue_types import OFFSETS, SppChoice
+from .catalogue.entries import OFFSETS, SppChoice
 from .samplers import Sampler, sampler, samplers
 
 __version__ = "0.1.0"

@@ -23,7 +23,7 @@ import threading
 import warnings
 
 from ._numpy.backend import NumpyBackend
-from .catalogue_types import check_choice
+from .catalogue.entries import check_choice
 
 BACKENDS = ("opencl", "numpy")
 ENV_BACKEND = "PYOA_BACKEND"

@@ -70,8 +70,8 @@ def sampler_codes() -> dict[str, int]:
 
 
 def offset_codes() -> list[tuple[str, int]]:
-    """``(name, code)`` of every offset style (pyoa.catalogue_types.OFFSET_CODES)."""
-    from .catalogue_types import OFFSET_CODES
+    """``(name, code)`` of every offset style (pyoa.catalogue.entries.OFFSET_CODES)."""
+    from .catalogue.entries import OFFSET_CODES
 
     return list(OFFSET_CODES.items())
 
@@ -92,7 +92,7 @@ def keys_header() -> str:
         "",
     ]
     lines += [f"#define PYOA_{name} 0x{value:08x}u" for name, value in sorted(kernel_keys().items())]
-    lines += ["", "/* The catalogue's codes (pyoa.catalogue: each sampler's `code`; pyoa.catalogue_types.OFFSET_CODES). */"]
+    lines += ["", "/* The catalogue's codes (pyoa.catalogue: each sampler's `code`; pyoa.catalogue.entries.OFFSET_CODES). */"]
     lines += [f"#define PYOA_SAMPLER_{name.upper()} {code}u" for name, code in sampler_codes().items()]
     lines += [f"#define PYOA_OFFSET_{name.upper()} {code}u" for name, code in offset_codes()]
     lines += ["", "#endif /* PYOA_KEYS_H */", ""]

@@ -40,7 +40,7 @@ import logging
 import os
 from collections.abc import Callable, Iterable, Iterator, Sequence
 
-from .catalogue_types import check_int
+from .catalogue.entries import check_int
 
 #: Environment variable naming a scheduler to use when ``--scheduler`` is not given.
 ENV_SCHEDULER = "PYOA_SCHEDULER"
@@ -464,8 +464,8 @@ def add_arguments(parser) -> None:
 
 
 def progress_over(results: Iterable, total: int, desc: str, quiet: bool, unit: str = "task"):
-    """``results`` with a progress bar of ``total`` steps (:func:`pyoa.progress.bar`; none when ``quiet``)."""
-    from .progress import bar as progress_bar
+    """``results`` with a progress bar of ``total`` steps (:func:`pyoa.util.progress.bar`; none when ``quiet``)."""
+    from .util.progress import bar as progress_bar
 
     with progress_bar(total=total, desc=desc, unit=unit, disable=quiet) as bar:
         for r in results:

@@ -82,9 +82,9 @@ from __future__ import annotations
 
 import ctypes
 
-from .drjit_llvm import configure as _configure_llvm
+from .util.drjit_llvm import configure as _configure_llvm
 
-_configure_llvm()  # before the LLVM backend starts (mi.set_variant('llvm_*')): see pyoa.drjit_llvm
+_configure_llvm()  # before the LLVM backend starts (mi.set_variant('llvm_*')): see pyoa.util.drjit_llvm
 
 try:
     import drjit as dr
@@ -93,7 +93,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without mitsuba
     raise ImportError("pyoa.mitsuba needs Mitsuba 3: pip install 'pyoa[mitsuba]'") from exc
 
 from . import _drjit
-from .catalogue_types import MAX_DIMS, MAX_UINT32
+from .catalogue.entries import MAX_DIMS, MAX_UINT32
 from .samplers import sampler as _pyoa_sampler
 
 #: Every option of the plugin, with its type as Mitsuba's Properties give it.

@@ -22,8 +22,8 @@ import warnings
 import numpy as np
 
 from .analysis import radial_mean  # noqa: F401  (pyoa.plots.radial_mean, as before)
-from .atomic import atomic_path, check_writable
-from .catalogue_types import MAX_UINT32, check_int
+from .util.atomic import atomic_path, check_writable
+from .catalogue.entries import MAX_UINT32, check_int
 from .samplers import sampler as make_sampler
 from .samplers import trial_options
 

@@ -22,9 +22,9 @@ import numpy as np
 from scipy.stats import qmc
 
 from . import catalogue
-from .catalogue_types import MAX_DIMS, MAX_UINT32
+from .catalogue.entries import MAX_DIMS, MAX_UINT32
 from .samplers import ENV_MAX_BYTES, Sampler, trial_options
-from .units import format_bytes
+from .util.units import format_bytes
 
 __all__ = ["PyoaEngine", "OrthogonalArray", "DEFAULT_SPP_TARGET"]
 

@@ -26,9 +26,9 @@ import numpy as np
 
 from . import catalogue
 from .backends import choose
-from .catalogue_types import MAX_DIMS, MAX_SPP, MAX_UINT32, check_int
-from .request import Request
-from .units import format_bytes
+from .catalogue.entries import MAX_DIMS, MAX_SPP, MAX_UINT32, check_int
+from .catalogue.request import Request
+from .util.units import format_bytes
 
 ENV_MAX_BYTES = "PYOA_MAX_BYTES"
 _UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
@@ -330,7 +330,7 @@ class Sampler:
     dims : int
         Number of dimensions.
     s : int
-        Coarse strata per axis (comparison samplers: see :mod:`pyoa.baselines`).
+        Coarse strata per axis (comparison samplers: see :mod:`pyoa.catalogue.baselines`).
     strength : int
         Strength t: every t-dimensional projection of a block is stratified
         (2 for the padded comparison samplers, 0 for random, halton and sobol).
@@ -507,7 +507,7 @@ class Sampler:
         chunks = [(r0, min(r0 + step, req.n_rows)) for r0 in range(0, req.n_rows, step)]
         bar = None
         if progress and len(chunks) > 1:
-            from .progress import bar as progress_bar
+            from .util.progress import bar as progress_bar
 
             bar = progress_bar(total=len(chunks), desc=f"pyoa {self.name}", unit="chunk")
 
@@ -903,7 +903,7 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         ``faure`` only (the others refuse it): its digit base, a prime in
         ``[2, 4093]``; ``b`` dimensions per block, every ``b**m`` samples a
         net. Default: the largest prime ``b`` with ``b**2 <= spp``, or the
-        smallest prime ``>= dims`` if smaller (see :class:`pyoa.progressive.Faure`).
+        smallest prime ``>= dims`` if smaller (see :class:`pyoa.catalogue.faure.Faure`).
         A pixel's samples do not depend on ``spp`` for a given base: give it
         to continue a sequence at another count.
     backend : {"opencl", "numpy"}, optional

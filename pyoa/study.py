@@ -63,9 +63,9 @@ import numpy as np
 
 from . import catalogue
 from .analysis.statistics import corrected, fit_loglog, mean_ci, ratio_ci
-from .atomic import atomic_path, check_not_inputs, check_writable
-from .catalogue_types import MAX_SPP, check_int
-from .units import format_interval, format_ratio
+from .util.atomic import atomic_path, check_not_inputs, check_writable
+from .catalogue.entries import MAX_SPP, check_int
+from .util.units import format_interval, format_ratio
 
 #: Samplers that stratify pairs of dimensions and pad them (the paper's "(pad)";
 #: pbrt-v4's zsobol and pmj02 pad their pairs the same way, docs/samplers.md).
@@ -237,7 +237,7 @@ def lock_study(d: Path):
     second waits on the old one).
 
     The file is made with the mode of every file pyoa writes
-    (:func:`pyoa.atomic.new_file_mode`), so the users of a group-shared
+    (:func:`pyoa.util.atomic.new_file_mode`), so the users of a group-shared
     ``--out`` can all lock it. One that this user may read but not write
     (made by another user under a stricter umask) is locked through a
     read-only descriptor, which ``flock`` accepts; the run cannot write its
@@ -245,7 +245,7 @@ def lock_study(d: Path):
     refused, never followed (truncating it would empty the file it names)."""
     import stat
 
-    from .atomic import new_file_mode
+    from .util.atomic import new_file_mode
     from .render.state import not_regular
 
     path = d / LOCK_NAME

@@ -147,7 +147,7 @@ def factor_prime_power(q: int) -> tuple[int, int] | None:
     return (p, r) if rest == 1 else None
 
 
-#: Every prime power that is not a prime, up to 256 (pyoa.gf's table limit).
+#: Every prime power that is not a prime, up to 256 (pyoa.tables.gf's table limit).
 GF_POWERS = [4, 8, 9, 16, 25, 27, 32, 49, 64, 81, 121, 125, 128, 169, 243, 256]
 
 #: Moduli (coefficients, constant term first) of GF(q): the classic ones
@@ -230,7 +230,7 @@ def is_irreducible(f: list[int], p: int) -> bool:
 
 
 class PolyField:
-    """GF(p**r) written independently of pyoa.gf: elements are codes whose base-p
+    """GF(p**r) written independently of pyoa.tables.gf: elements are codes whose base-p
     digits are polynomial coefficients (constant term least significant, SPEC
     section 5), multiplied as polynomials and reduced by the monic modulus ``f``."""
 
@@ -267,11 +267,11 @@ def prime_field(q: int) -> PolyField:
 
 def field_for(q: int) -> PolyField:
     """GF(q) for prime q (mod q); else over the modulus of :data:`KNOWN_MODULI`, or
-    for the other q pyoa.gf's modulus (tests/test_gf.py checks it is the first
+    for the other q pyoa.tables.gf's modulus (tests/test_gf.py checks it is the first
     monic irreducible polynomial, independently)."""
     if factor_prime_power(q)[1] == 1:
         return prime_field(q)
-    from pyoa import gf
+    from pyoa.tables import gf
 
     return PolyField(q, KNOWN_MODULI.get(q) or gf.modulus(q))
 
@@ -306,7 +306,7 @@ def bush_symbol(i: int, j: int, t: int, F: PolyField) -> int:
 
 @functools.cache
 def field_tables(q: int) -> tuple[np.ndarray, np.ndarray]:
-    """(add, mul) q x q tables of :func:`field_for` (independent of pyoa.gf), cached."""
+    """(add, mul) q x q tables of :func:`field_for` (independent of pyoa.tables.gf), cached."""
     F = field_for(q)
     add = np.array([[F.add(a, b) for b in range(q)] for a in range(q)], dtype=np.int64)
     mul = np.array([[F.mul(a, b) for b in range(q)] for a in range(q)], dtype=np.int64)
@@ -357,7 +357,7 @@ BB_S = [2, 4, 8, 16, 32]
 
 
 def index2_levels(name: str) -> list[int]:
-    """Every s of an index-2 sampler, enumerated independently of pyoa.constructions:
+    """Every s of an index-2 sampler, enumerated independently of pyoa.catalogue.constructions:
     Addelman-Kempthorne q odd, a prime or a prime power <= 256, 2q^2 <= 2^24;
     Bose-Bush s = 2^r with 2s <= 256 (GF(2s) tables)."""
     if name == "bose-bush":
@@ -374,7 +374,7 @@ def index2_levels(name: str) -> list[int]:
 def field_inverses(q: int) -> tuple[int, ...]:
     """``inv[a]`` (``inv[0] = 0``) in :func:`field_for` GF(q), from the powers of a
     primitive element (``inv(g^e) = g^(q-1-e)``): no Fermat exponentiation, no tables
-    of pyoa.gf."""
+    of pyoa.tables.gf."""
     F = field_for(q)
     for g in range(2, q) if q > 2 else [1]:
         powers, x = [1], g
@@ -446,7 +446,7 @@ def ak_symbol(i: int, j: int, q: int) -> tuple[int, int]:
 @functools.cache
 def plain_ak_array(q: int, kappa: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(A, U)``, each (2q^2, 2q+1): :func:`ak_symbol` over the whole array,
-    vectorized over :func:`field_tables` (independent of pyoa.gf); read-only, cached.
+    vectorized over :func:`field_tables` (independent of pyoa.tables.gf); read-only, cached.
     ``kappa``: see :func:`ak_constants_independent`."""
     add, mul = field_tables(q)
     kappa, b, k, c = (np.asarray(v) for v in ak_constants_independent(q, kappa))

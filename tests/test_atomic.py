@@ -1,4 +1,4 @@
-"""pyoa.atomic.atomic_path: a failed write never replaces a good file."""
+"""pyoa.util.atomic.atomic_path: a failed write never replaces a good file."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import stat
 
 import pytest
 
-from pyoa.atomic import atomic_path
+from pyoa.util.atomic import atomic_path
 
 
 def test_success_replaces_and_cleans_up(tmp_path):
@@ -136,7 +136,7 @@ def test_rename_error_names_the_users_path(tmp_path, monkeypatch):
 
 
 def test_check_writable(tmp_path):
-    from pyoa.atomic import check_writable
+    from pyoa.util.atomic import check_writable
 
     target = tmp_path / "out.png"
     assert check_writable(target) == target

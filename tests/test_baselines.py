@@ -1,4 +1,4 @@
-"""Properties of the comparison samplers (pyoa.baselines): random, jittered2d,
+"""Properties of the comparison samplers (pyoa.catalogue.baselines): random, jittered2d,
 cmj2d, sobol02, halton and sobol.
 
 What the docstrings of :mod:`pyoa.reference.baselines` promise, checked on the
@@ -50,7 +50,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import pyoa
-from pyoa import sequences
+from pyoa.tables import sequences
 from pyoa._numpy import baselines as nb
 from pyoa._numpy.floats import jitter_value
 from pyoa._numpy.hashes import permute, pixel_seed, randfloat
@@ -73,7 +73,7 @@ seeds = st.integers(0, U32_MAX)
 # =============================================================================== helpers
 
 def independent_primes(count: int) -> list[int]:
-    """The first ``count`` primes by trial division (not pyoa.sequences' sieve)."""
+    """The first ``count`` primes by trial division (not pyoa.tables.sequences' sieve)."""
     out: list[int] = []
     n = 2
     while len(out) < count:
@@ -605,7 +605,7 @@ def test_sobol_unscrambled_last_dimensions_equal_scipy():
 def joe_kuo_directions(poly: int, vinit, bits: int = 32) -> list[int]:
     """The direction numbers V_1..V_bits of one dimension, written from Joe and
     Kuo's generator (the "V form" of the Bratley-Fox recurrence, not the m form
-    pyoa.sequences uses): V_i = m_i 2^(32-i) for i <= s, then
+    pyoa.tables.sequences uses): V_i = m_i 2^(32-i) for i <= s, then
     V_i = V_(i-s) ^ (V_(i-s) >> s) ^ XOR_(k=1..s-1) a_k V_(i-k), where SciPy's
     ``poly`` holds x^s + a_1 x^(s-1) + ... + a_(s-1) x + 1 as bits."""
     s = poly.bit_length() - 1

@@ -26,7 +26,7 @@ import pyoa
 import pyoa.catalogue
 import pyoa._numpy.backend as numpy_backend
 from pyoa import reference as ref
-from pyoa import sequences
+from pyoa.tables import sequences
 from pyoa._numpy import baselines as nbl
 from pyoa.reference import baselines as rbl
 from tests.helpers import PIXEL_KEY, U32_MAX, assert_same_bits, kernel_runner

@@ -2,7 +2,7 @@
 
 The header's functions, built into a shared library as C99 and as C++14
 (warnings as errors), must accept exactly the requests :class:`pyoa.Sampler`
-accepts, resolve them to the same parameters (:mod:`pyoa.params`, ``shape_args``)
+accepts, resolve them to the same parameters (:mod:`pyoa.catalogue.params`, ``shape_args``)
 and refuse the others with the same error kind and the same message (the
 nearest valid counts, the samplers that accept the count). The Python side
 is the oracle throughout: :func:`expect` runs the steps of
@@ -32,9 +32,9 @@ from hypothesis import strategies as st
 import pyoa
 from pyoa import catalogue
 from pyoa.samplers import _offset
-from pyoa.catalogue_types import MAX_DIMS, MAX_SPP, REGISTRY, _labels, check_int
-from pyoa.params import OAParams, PointSetParams
-from pyoa.progressive import BASES
+from pyoa.catalogue.entries import MAX_DIMS, MAX_SPP, REGISTRY, _labels, check_int
+from pyoa.catalogue.params import OAParams, PointSetParams
+from pyoa.catalogue.faure import BASES
 
 from .test_c_headers import INCLUDE, WARN, compile_, need
 
@@ -92,7 +92,7 @@ def quick_choices():
 
 def flat_params(construction, prm, dims) -> tuple:
     """``(s, strength, block_dims, M, dims)`` of C's pyoa_params for Python's
-    parameters (pyoa.params: one type per family), which C holds in one flat
+    parameters (pyoa.catalogue.params: one type per family), which C holds in one flat
     struct: the listing's s, strength and block_dims (``construction.choice``);
     M an OA's sub-strata, cmj2d's second side, jittered2d's 1 and every other
     sampler's count; dims 0 for an OA (none depends on it)."""

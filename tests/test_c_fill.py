@@ -33,7 +33,7 @@ from hypothesis import strategies as st
 
 import pyoa
 from pyoa import catalogue
-from pyoa.catalogue_types import OFFSETS
+from pyoa.catalogue.entries import OFFSETS
 from tests.test_c_headers import INCLUDE, WARN, need
 
 SHIM = Path(__file__).parent / "c" / "fill_shim.c"

@@ -1,5 +1,5 @@
 """The C pmj02 table builder (kernels/include/pyoa/pmj02_build.h) against
-pyoa.pmj02_tables and pyoa.reference.pmj02: the whole table bit for bit
+pyoa.tables.pmj02 and pyoa.reference.pmj02: the whole table bit for bit
 (its SHA-256 is the pinned TABLE_SHA256), single sets built with caller
 scratch, prefixes of other sets against the reference's build_set, and the
 builder's parts (draw, uniform index, Pharr's strata walk on random
@@ -7,7 +7,7 @@ occupancies, where the walk branches as it never does in pmj02).
 
 The shim (tests/c/pmj02_shim.c) is built as C99 and as C++14 with -O2 and
 warnings as errors. ``PYOA_REQUIRE_C=1`` makes a missing gcc/g++ a failure.
-The Python table comes from pyoa.pmj02_tables.tables(): from its disk cache,
+The Python table comes from pyoa.tables.pmj02.tables(): from its disk cache,
 or built once (numba, 5-12 s) when the cache is cold.
 """
 
@@ -26,7 +26,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from pyoa import c_headers
-from pyoa import pmj02_tables as T
+from pyoa.tables import pmj02 as T
 from pyoa.reference import pmj02_build as B
 
 INCLUDE = Path(c_headers.get_include())
@@ -163,7 +163,7 @@ def test_strata_walk_matches_the_reference(lib, walk, axis):
 
 def test_whole_table_matches_python_bit_for_bit(lib, table):
     """pyoa_pmj02_fill into a buffer of garbage (all ones: its top bytes hold
-    the occupancy during the build) gives pyoa.pmj02_tables.tables()."""
+    the occupancy during the build) gives pyoa.tables.pmj02.tables()."""
     out = np.full(T.SHAPE, U32, np.uint32)
     t0 = time.perf_counter()
     rc = lib.t_pmj02_fill(ptr(out))

@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 
 import pyoa
 from pyoa import catalogue, c_headers
-from pyoa.catalogue_types import OFFSETS
+from pyoa.catalogue.entries import OFFSETS
 from tests.test_c_headers import INCLUDE, WARN, compile_, need
 
 SHIM = Path(__file__).parent / "c" / "sampler_shim.c"

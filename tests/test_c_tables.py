@@ -8,11 +8,11 @@ uploads (docs/spec.md sections 5.1, 5.6 and 5.8):
 - Addelman-Kempthorne: ``AddelmanKempthorne.constants`` for every q
   ``AddelmanKempthorne.levels()`` allows (426 of them). The prime powers,
   the primes below 300 and the largest ones are compared with
-  ``pyoa.gf.ak_constants`` itself; every q with a vectorized NumPy
-  evaluation of the same definition (pyoa.gf's scalar loop over all 426 would
-  take ten seconds), which on the first set must then agree with pyoa.gf too;
-- Halton: ``pyoa.sequences.primes()``, whole;
-- Sobol: ``pyoa.sequences.sobol_matrices()[:dims]`` for 1, 2, 1000 and all
+  ``pyoa.tables.gf.ak_constants`` itself; every q with a vectorized NumPy
+  evaluation of the same definition (pyoa.tables.gf's scalar loop over all 426 would
+  take ten seconds), which on the first set must then agree with pyoa.tables.gf too;
+- Halton: ``pyoa.tables.sequences.primes()``, whole;
+- Sobol: ``pyoa.tables.sequences.sobol_matrices()[:dims]`` for 1, 2, 1000 and all
   21201 dimensions, from the generated ``sobol_data.h`` (which must equal
   ``pyoa.c_data.sobol_data_header()``).
 
@@ -34,9 +34,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyoa import c_data, c_headers, gf, sequences
+from pyoa import c_data, c_headers
+from pyoa.tables import gf, sequences
 from pyoa._opencl.backend import _field_tables
-from pyoa.constructions import AddelmanKempthorne
+from pyoa.catalogue.constructions import AddelmanKempthorne
 from tests.helpers import GF_POWERS, factor_prime_power
 from tests.test_c_headers import WARN, compile_, need
 
@@ -48,7 +49,7 @@ BUILDS = {
     "c++14-O2": ("g++", ".cpp", ["-std=c++14", "-O2", *WARN]),
 }
 AK_LEVELS = AddelmanKempthorne.levels()
-#: Addelman-Kempthorne q compared with pyoa.gf.ak_constants itself: every odd
+#: Addelman-Kempthorne q compared with pyoa.tables.gf.ak_constants itself: every odd
 #: composite prime power, the primes below 300, every 20th level and the three largest.
 AK_DIRECT = sorted({q for q in AK_LEVELS if factor_prime_power(q)[1] > 1 or q < 300}
                    | set(AK_LEVELS[::20]) | set(AK_LEVELS[-3:]))
@@ -102,7 +103,7 @@ def expected_info(q: int, pr) -> tuple:
 def test_gf_info_matches_pyoa_gf_up_to_4096(lib):
     """prime_power, is_supported, tabled, the table size and the modulus (of
     every q = p^r with r >= 2: the first monic irreducible polynomial,
-    pyoa.gf.modulus) for every q <= 4096 as pyoa.gf says, and large q up to
+    pyoa.tables.gf.modulus) for every q <= 4096 as pyoa.tables.gf says, and large q up to
     the edge of uint32."""
     qs = list(range(0, 4097))
     got = gf_info(lib, qs)
@@ -204,12 +205,12 @@ def test_ak_constants_equal_pyoa_gf(lib, q):
     want = ak_upload(q)
     assert np.array_equal(got, want), (q, np.flatnonzero(got != want)[:5])
     if factor_prime_power(q)[1] == 1:
-        assert ak_fast(q) == want.tolist(), q  # the fast oracle of the next test is pyoa.gf's
+        assert ak_fast(q) == want.tolist(), q  # the fast oracle of the next test is pyoa.tables.gf's
 
 
 def test_ak_constants_of_every_level(lib):
     """All 426 q of AddelmanKempthorne.levels(): the composite prime powers
-    against pyoa.gf (cached by the test above), the primes against ak_fast."""
+    against pyoa.tables.gf (cached by the test above), the primes against ak_fast."""
     for q in AK_LEVELS:
         got = fill(lib, "t_ak_fill", lib.t_ak_entries(q), np.uint32, q)
         want = ak_upload(q) if factor_prime_power(q)[1] > 1 else ak_fast(q)
@@ -218,7 +219,7 @@ def test_ak_constants_of_every_level(lib):
 
 @pytest.mark.parametrize("q", [0, 1, 2, 4, 8, 15, 256])
 def test_ak_zeros_for_q_without_constants(lib, q):
-    """q not an odd prime power (pyoa.gf.ak_constants raises): 1 + 3q zeros."""
+    """q not an odd prime power (pyoa.tables.gf.ak_constants raises): 1 + 3q zeros."""
     with pytest.raises(ValueError):
         gf.ak_constants(q)
     assert lib.t_ak_entries(q) == 1 + 3 * q

@@ -30,9 +30,9 @@ from hypothesis import strategies as st
 
 import pyoa
 from pyoa import catalogue
-from pyoa.baselines import Baseline
-from pyoa.catalogue_types import REGISTRY, Claim
-from pyoa.params import FaureParams, OAParams, PointSetParams, SequenceParams
+from pyoa.catalogue.baselines import Baseline
+from pyoa.catalogue.entries import REGISTRY, Claim
+from pyoa.catalogue.params import FaureParams, OAParams, PointSetParams, SequenceParams
 from tests.helpers import U32_MAX, assert_same_bits, net_failures, reference_block
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -83,7 +83,7 @@ def test_every_entry_is_complete_and_its_cases_resolve():
             assert smp.spp == kw["spp"] and smp.dims == kw["dims"]
 
 
-#: The parameter type each family resolves to (pyoa.params), per entry class.
+#: The parameter type each family resolves to (pyoa.catalogue.params), per entry class.
 PARAMETER_TYPES = {"bose": OAParams, "bush": OAParams, "cmjnd": OAParams, "addelman-kempthorne": OAParams,
                    "bose-bush": OAParams, "jittered2d": PointSetParams, "cmj2d": PointSetParams,
                    "faure": FaureParams}
@@ -122,7 +122,7 @@ def test_family_is_read_only_to_list_samplers():
 
 
 def test_register_refuses_a_taken_name_or_code():
-    from pyoa import catalogue_types as ct
+    from pyoa.catalogue import entries as ct
 
     bose = type(catalogue.get("bose"))
     with pytest.raises(ValueError, match="registered twice"):

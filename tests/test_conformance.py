@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 import pyoa
 from pyoa import reference as ref
 from pyoa._numpy import hashes as nh
-from pyoa import gf
+from pyoa.tables import gf
 from tests.helpers import (
     AK_Q,
     BB_S,
@@ -101,7 +101,7 @@ def configs(draw):
                            min_size=1, max_size=2 if many else 3))
     if many:
         # the pure-Python reference of GF arithmetic costs ~1 ms a value at s ~ 4093
-        # (pyoa.gf factors s on every call); such s never reach the table path (E > 300) anyway
+        # (pyoa.tables.gf factors s on every call); such s never reach the table path (E > 300) anyway
         slow = name != "cmjnd" and s > 256
         n = min(spp, draw(st.integers(1, 24 if slow else 300)))
         start = draw(st.integers(0, spp - n))
@@ -321,7 +321,7 @@ def test_largest_bush(backend, s, t):
 def _tabled_equals_direct(smp, monkeypatch, pixels, samples=None, dims=None):
     """Generate a block on the table path (asserting that it is taken), then with
     tables switched off (the direct path); assert the same bits and return the block."""
-    from pyoa.request import Request
+    from pyoa.catalogue.request import Request
 
     req = smp._request(pixels, samples, dims)
     assert all(req.tables_pay_off(rect) for rect in req.rectangles(0, req.n_rows))

@@ -1,5 +1,5 @@
 """``faure``: Owen-scrambled Faure (0, s)-sequences in a prime base
-(pyoa/progressive.py, pyoa/reference/faure.py, pyoa/_numpy/faure.py,
+(pyoa/catalogue/faure.py, pyoa/reference/faure.py, pyoa/_numpy/faure.py,
 kernels/include/pyoa/faure.h), exactly.
 
 - Nets: every aligned block of ``b**m`` samples of a pixel is a (0, m, b)-net
@@ -42,7 +42,7 @@ from hypothesis import strategies as st
 
 import pyoa
 from pyoa import catalogue
-from pyoa import progressive as prog
+from pyoa.catalogue import faure as prog
 from pyoa._numpy import faure as nf
 from pyoa.qmc import OrthogonalArray
 from pyoa.reference import faure as rf
@@ -557,7 +557,7 @@ def test_default_base(spp, dims, want):
 
 
 def test_the_docstring_examples_of_the_default_base():
-    """pyoa.progressive's examples: ``default_base(121), default_base(1000),
+    """pyoa.catalogue.faure's examples: ``default_base(121), default_base(1000),
     default_base(1000, dims=5), default_base(3)`` and the class docstring's
     ``spp=1000`` with 40, 8 and 5 dimensions."""
     assert (prog.default_base(121), prog.default_base(1000), prog.default_base(1000, dims=5),

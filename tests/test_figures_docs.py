@@ -244,8 +244,8 @@ def test_docs_say_which_cornell_surfaces_are_one_sided():
 
 def test_docs_state_one_pmj02_build_time():
     """The pmj02 table's first build (numba's compile included) depends on the CPU: every doc that times it
-    gives the range of :mod:`pyoa.pmj02_tables`' docstring, which names the CPUs measured."""
-    from pyoa import pmj02_tables
+    gives the range of :mod:`pyoa.tables.pmj02`' docstring, which names the CPUs measured."""
+    from pyoa.tables import pmj02 as pmj02_tables
 
     doc = " ".join(pmj02_tables.__doc__.split())
     (figure,) = re.findall(r"(\d+-\d+ s) in all", doc)

@@ -1,4 +1,4 @@
-"""pyoa.gf: the Galois fields GF(q) behind Bose over prime powers and Bush.
+"""pyoa.tables.gf: the Galois fields GF(q) behind Bose over prime powers and Bush.
 
 Checked against field axioms on the lookup tables (every prime power q <= 256
 that is not a prime; prime q use plain mod-q arithmetic), and against an
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pyoa import gf
+from pyoa.tables import gf
 from tests.helpers import (
     GF_POWERS,
     KNOWN_MODULI,
@@ -307,7 +307,7 @@ AK_CONST_Q = [9, 25, 27, 49, 81, 121, 125, 169, 243, 3, 5, 7, 11, 13, 251, 2887]
 
 @pytest.mark.parametrize("q", AK_CONST_Q)
 def test_ak_constants_satisfy_their_definitions(q):
-    """pyoa.gf.ak_constants(q) = (kappa, b, k, c): kappa is a non-square of GF(q)
+    """pyoa.tables.gf.ak_constants(q) = (kappa, b, k, c): kappa is a non-square of GF(q)
     and the smallest one by code; for m = 1..q-1, b[m] * 4 kappa m = kappa - 1,
     k[m] = kappa m and 4 c[m] = m^2 (kappa - 1), checked by multiplication only
     in the independent field (4 = 1+1+1+1, which is 1 in characteristic 3);

@@ -235,7 +235,7 @@ def test_pixel_identity_is_of_the_pixels():
 
 
 def test_the_lock_file_gets_the_mode_of_every_output(tmp_path):
-    """0o666 less the umask, as pyoa.atomic gives its outputs: under umask 002 (a group-shared --out) the
+    """0o666 less the umask, as pyoa.util.atomic gives its outputs: under umask 002 (a group-shared --out) the
     group may open it for writing too."""
     old = os.umask(0o002)
     try:

@@ -1,8 +1,8 @@
-"""The host CPU as reports name it (pyoa.hostcpu)."""
+"""The host CPU as reports name it (pyoa.util.hostcpu)."""
 
 from __future__ import annotations
 
-from pyoa.hostcpu import HostCPU, _parse_cpuinfo, host_cpu
+from pyoa.util.hostcpu import HostCPU, _parse_cpuinfo, host_cpu
 
 ZEN5 = """processor\t: 0
 vendor_id\t: AuthenticAMD

@@ -1,4 +1,4 @@
-"""The public API of the samplers ``zsobol`` and ``pmj02`` (pyoa/baselines.py).
+"""The public API of the samplers ``zsobol`` and ``pmj02`` (pyoa/catalogue/baselines.py).
 
 ``resolution=(width, height)``: required by zsobol, refused by every other
 sampler, validated, and bounding the pixel indices (``Sampler.n_pixels``);

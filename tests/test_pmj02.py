@@ -1,4 +1,4 @@
-"""pmj02: the table (pyoa.pmj02_tables), its builders and cache, and the sampler
+"""pmj02: the table (pyoa.tables.pmj02), its builders and cache, and the sampler
 values of the three backends (pyoa.reference.pmj02, pyoa._numpy.pmj02,
 kernels/include/pyoa/pmj02.h).
 
@@ -9,7 +9,7 @@ v))``, and a set of ``2**m`` points is a (0,m,2)-net iff, for every ``u``,
 the ``2**m`` combined interval codes are all different (:func:`net_failures`
 counts them with :func:`numpy.bincount`, all sets at once).
 
-The module builds the table once, through :func:`pyoa.pmj02_tables.tables`
+The module builds the table once, through :func:`pyoa.tables.pmj02.tables`
 with ``PYOA_CACHE_DIR`` pointing at a temporary directory (so the numba build
 and the cache write run for real, and nothing is written under ``~``).
 """
@@ -27,7 +27,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from pyoa import pmj02_tables as T
+from pyoa.tables import pmj02 as T
 from pyoa import reference
 from pyoa._numpy import pmj02 as npmj
 from pyoa._numpy.hashes import pixel_seed

@@ -76,11 +76,11 @@ def test_bars_are_lines_when_standard_error_is_not_a_terminal(tmp_path):
 
 
 def test_a_bar_on_a_log_writes_a_line_per_tenth_and_its_last_state():
-    """:func:`pyoa.progress.bar` on a stream that is no terminal: a line at the start, at each tenth
+    """:func:`pyoa.util.progress.bar` on a stream that is no terminal: a line at the start, at each tenth
     it passes, and at the end, each whole; tqdm's ``write`` between lines takes nothing back."""
     import io
 
-    from pyoa import progress
+    from pyoa.util import progress
 
     log = io.StringIO()
     bar = progress.bar(total=10, desc="job", unit="step", file=log, mininterval=0)

@@ -172,7 +172,7 @@ def test_bush_impossible_strength_names_valid_counts(strength):
 
 
 def test_valid_spp_bush_and_gf_bose():
-    from pyoa import gf
+    from pyoa.tables import gf
 
     bush = pyoa.valid_spp("bush")
     assert bush[:4] == [pyoa.SppChoice(4, 2, 2, 3), pyoa.SppChoice(9, 3, 2, 4), pyoa.SppChoice(16, 4, 2, 5),
@@ -249,7 +249,8 @@ def test_valid_spp_index2():
 def test_addelman_kempthorne_kernel_constants_layout():
     """What the kernels read for Addelman-Kempthorne: [kappa, b[0..q), k[0..q), c[0..q)]
     (pyoa/oa.h indexes ak[1 + m], ak[1 + q + m], ak[1 + 2q + m]); nothing for the others."""
-    from pyoa import catalogue as constructions, gf
+    from pyoa import catalogue as constructions
+    from pyoa.tables import gf
 
     for q in (3, 27, 243, 2887):
         c = constructions.get("addelman-kempthorne")

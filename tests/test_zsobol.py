@@ -20,7 +20,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from pyoa import sequences
+from pyoa.tables import sequences
 from pyoa._numpy import zsobol as nz
 from pyoa.reference import baselines as rbl
 from pyoa.reference import zsobol as rz

@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .. import gf
+from ..tables import gf
 from ..reference import oa as G  # the constructions' geometries (N, B, s, M)
 from .blocks import locate
 from .floats import jitter_value, sample_value
@@ -27,7 +27,7 @@ from .hashes import dimension_seeds, permute, permutes, randfloat
 
 class Field:
     """GF(q) arithmetic on uint32 code arrays: mod q for a prime q, else
-    gathers from :func:`pyoa.gf.tables` (the tables the kernels read too)."""
+    gathers from :func:`pyoa.tables.gf.tables` (the tables the kernels read too)."""
 
     def __init__(self, xp, q: int):
         self.xp, self.q = xp, q
@@ -101,7 +101,7 @@ def cmjnd_cell(xp, i, col, s: int):
 
 @lru_cache(maxsize=None)
 def _ak_tables(q: int) -> tuple:
-    """:func:`pyoa.gf.ak_constants`: kappa, and b, k, c as host uint32 arrays."""
+    """:func:`pyoa.tables.gf.ak_constants`: kappa, and b, k, c as host uint32 arrays."""
     kappa, *tables = gf.ak_constants(q)
     return (kappa, *(np.asarray(v, dtype=np.uint32) for v in tables))
 

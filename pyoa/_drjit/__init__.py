@@ -22,7 +22,7 @@ sampler, over Dr.Jit arrays.
 
 from __future__ import annotations
 
-from ..drjit_llvm import configure as _configure_llvm
+from ..util.drjit_llvm import configure as _configure_llvm
 
 _configure_llvm()  # before Dr.Jit's LLVM backend starts: an LLVM that compiles Mitsuba 3.9's kernels
 

@@ -1,7 +1,7 @@
 """The catalogue's entries in Dr.Jit: which are supported, and x(pixel, i, j) for them.
 
 An entry's Dr.Jit implementation is called exactly as its other three are
-(:class:`pyoa.catalogue_types.Construction`): ``function(i, j,
+(:class:`pyoa.catalogue.entries.Construction`): ``function(i, j,
 *shape_args(params), *seed_args(pixel_seed, seed, pixel), *options(offset,
 jitter))``, with this package's :func:`.hashes.pixel_seed`.
 """

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import host_tables
+from ..catalogue import host_tables
 from ..reference.hashes import JITTER_KEY, STRATUM_KEY, SUBSTRATUM_KEY
-from ..request import Rect, Request
+from ..catalogue.request import Rect, Request
 from . import oa
 from .floats import F32, jitter_value, sample_value
 from .hashes import U32, permute, randfloat
@@ -68,12 +68,12 @@ class NumpyBackend:
         value (:meth:`_values_at`).
 
         Block 0 reads row ``i``, so its cells do not depend on the pixel
-        (:func:`pyoa.host_tables.cells`). A later block ``b`` reads its copy
+        (:func:`pyoa.catalogue.host_tables.cells`). A later block ``b`` reads its copy
         at row ``block_row(i, N, r_b)`` (docs/spec.md section 6), a
         different row per pixel. Where the rectangle holds at least ``N``
         samples per pixel, such a block is evaluated in row space: its values
         at every row ``0..N-1`` of the array, whose cells depend on the
-        column only (:func:`pyoa.host_tables.array_cells`), then gathered
+        column only (:func:`pyoa.catalogue.host_tables.array_cells`), then gathered
         along the sample axis at each pixel's rows. That is block 0's work
         plus the rows and one gather, and never more values than the
         rectangle holds. A shorter run of samples (a subset of them, or the
@@ -176,7 +176,7 @@ class NumpyBackend:
         aij, u : numpy.ndarray
             The cells ``A_ij`` and sub-stratum indices of those rows in the
             dimensions' columns: shape ``(dims, n_rows)`` for a shared run of
-            rows (:func:`pyoa.host_tables.cells` and ``array_cells``' layout),
+            rows (:func:`pyoa.catalogue.host_tables.cells` and ``array_cells``' layout),
             else broadcastable to ``(pixels, n_rows, dims)``. ``u`` is unused
             for ``centered``.
         tables : tuple

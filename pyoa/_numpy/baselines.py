@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import sequences
+from ..tables import sequences
 from ..reference.baselines import (
     DIGIT_KEY,
     HALTON_KEY,

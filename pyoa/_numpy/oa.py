@@ -3,7 +3,7 @@ and the block rule of :mod:`pyoa._arrays.blocks`, bound to :mod:`.ops`.
 
 The pieces (block rule, cells, field) are public to this package because
 the NumPy backend's table path (:mod:`.backend`) and the host tables
-(:mod:`pyoa.host_tables`) reuse them.
+(:mod:`pyoa.catalogue.host_tables`) reuse them.
 """
 
 from __future__ import annotations

@@ -21,13 +21,13 @@ def pmj02(i, j, log2n: int, p) -> np.ndarray:
     """Vectorized :func:`pyoa.reference.pmj02.pmj02`: float32 values ``k * 2**-24``.
 
     ``h = derived_seed(p, j >> 1, PMJ02_KEY)`` picks the set ``h >> 28`` of
-    :func:`pyoa.pmj02_tables.tables` and seeds the 24-bit digital shift
+    :func:`pyoa.tables.pmj02.tables` and seeds the 24-bit digital shift
     ``derived_seed(h, 1 + (j & 1), PMJ02_SHIFT_KEY) >> 8`` of coordinate
     ``j & 1``; the sample index is Owen-scrambled within the whole set (seed
     ``derived_seed(h, 0, PMJ02_SHIFT_KEY)``), not within ``N``, so ``log2n``
     (the caller's bound on ``i``) does not enter the values.
     """
-    from ..pmj02_tables import tables
+    from ..tables.pmj02 import tables
 
     # at least 1-D: NumPy's uint32 scalars warn on the wrap-around the hashes rely on
     i, j, p = np.broadcast_arrays(np.asarray(i, dtype=U32), np.asarray(j, dtype=U32), np.asarray(p, dtype=U32))

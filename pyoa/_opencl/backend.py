@@ -6,8 +6,8 @@ import threading
 
 import numpy as np
 
-from .. import gf
-from ..request import Rect, Request
+from ..tables import gf
+from ..catalogue.request import Rect, Request
 from . import vector
 from .choice import open_device
 from .device import DeviceInfo
@@ -298,7 +298,7 @@ class OpenCLBackend:
         values ``[at, at + rect values)`` of ``buf``. Called with self._lock held."""
         import pyopencl as cl
 
-        from ..host_tables import block_seeds, cells, table_keys
+        from ..catalogue.host_tables import block_seeds, cells, table_keys
 
         ro = cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR
         prm = req.params
@@ -357,9 +357,9 @@ class OpenCLBackend:
         return kept[1]
 
     def _array_cells(self, req: Request) -> tuple:
-        """Device buffers of :func:`pyoa.host_tables.array_cells` of ``req``,
+        """Device buffers of :func:`pyoa.catalogue.host_tables.array_cells` of ``req``,
         uploaded once per request shape. Called with self._lock held."""
-        from ..host_tables import array_cells
+        from ..catalogue.host_tables import array_cells
 
         return self._kept_upload("cells", (req.construction.name, req.params, req.offset, req.dims.tobytes()),
                                  lambda: array_cells(req))

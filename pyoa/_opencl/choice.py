@@ -18,7 +18,7 @@ import re
 import threading
 from dataclasses import dataclass
 
-from ..hostcpu import host_cpu
+from ..util.hostcpu import host_cpu
 from . import program
 from .device import (
     ENV_DEVICE,

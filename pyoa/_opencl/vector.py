@@ -24,7 +24,7 @@ offset, when
   2D samplers' kernel stops at :data:`MAX_WHOLE_ROWS`),
 - a dimension past the first block reads its copy at its own rows
   (docs/spec.md section 6), from the records of every row of the array
-  (:func:`row_records`), which must fit :data:`pyoa.request.MAX_ARRAY_CELLS`
+  (:func:`row_records`), which must fit :data:`pyoa.catalogue.request.MAX_ARRAY_CELLS`
   words,
 - the stratum permutation fits 4-bit fields (s <= 16) or its bounded walk
   takes at most :data:`MAX_ROUNDS` rounds, and the sub-stratum permutation
@@ -45,10 +45,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import catalogue_types
-from ..params import OAParams, PointSetParams
+from ..catalogue import entries
+from ..catalogue.params import OAParams, PointSetParams
 from ..reference.hashes import walk_mask
-from ..request import MAX_ARRAY_CELLS, Rect, Request
+from ..catalogue.request import MAX_ARRAY_CELLS, Rect, Request
 
 #: Lanes per vector: 8 (AVX2's width; on AVX-512, 16 lanes measured slower).
 LANES = 8
@@ -167,7 +167,7 @@ class Shape(_Rows):
         """The ``#define`` lines that open the program text."""
         return self._header({
             "VS": f"{self.s}u", "VM": f"{self.M}u", "VWS": f"{walk_mask(self.s)}u", "VWM": f"{walk_mask(self.M)}u",
-            "VDMAX": f"{self.block_dims}u", "VOFFSET": catalogue_types.OFFSET_CODES[self.offset],
+            "VDMAX": f"{self.block_dims}u", "VOFFSET": entries.OFFSET_CODES[self.offset],
             "VS_PACKED": int(self.s_packed), "VS_ROUNDS": f"{walk_rounds(self.s)}u",
             "VSUB": self.sub, "VSUB_ROUNDS": f"{walk_rounds(self.M)}u", "VJKEY_BOSE": int(self.jkey_bose),
             "VN": f"{self.s * self.M}u", "VWN": f"{walk_mask(self.s * self.M)}u", "VLATER": int(self.later),
@@ -276,7 +276,7 @@ def row_records(req: Request, shp: Shape) -> np.ndarray:
     shp.record_words)``.
 
     The cell of column ``c`` (docs/spec.md section 5: ``A_ij`` and ``u`` of
-    the row, pyoa.constructions' cell functions) is ``A_ij | u << a_bits``,
+    the row, pyoa.catalogue.constructions' cell functions) is ``A_ij | u << a_bits``,
     ``cell_bits`` wide, at bit ``(c % per_word) * cell_bits`` of word ``c //
     per_word``, ``per_word = 32 // cell_bits``; ``u`` is left out for
     'centered'. A block's rows are a permutation of these rows per (pixel,
@@ -384,7 +384,7 @@ def cell_arrays(req: Request, shp: Shape) -> tuple[np.ndarray, np.ndarray, np.nd
     kernel's ``vload8`` reads whole blocks; padded lanes are never stored).
     A dimension past block 0 reads its cells from its block's row records
     (:func:`row_records`) instead, and its row here is never read."""
-    from ..host_tables import cells
+    from ..catalogue.host_tables import cells
 
     pad = shp.n_k_padded - shp.n_k
     samples = np.pad(req.samples, (0, pad))

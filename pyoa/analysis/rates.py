@@ -128,7 +128,7 @@ class ConvergenceResult:
         sampler with its fitted slope in the legend.
 
         Uses Matplotlib's Agg canvas directly (no pyplot state, no backend
-        switch) and writes atomically (:func:`pyoa.atomic.atomic_path`); the
+        switch) and writes atomically (:func:`pyoa.util.atomic.atomic_path`); the
         format follows the suffix (``.png`` by default when there is none).
 
         Parameters
@@ -145,7 +145,7 @@ class ConvergenceResult:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
-        from ..atomic import atomic_path
+        from ..util.atomic import atomic_path
 
         if metric not in ("variance", "mse"):
             raise ValueError(f"metric must be 'variance' or 'mse', got {metric!r}")

@@ -56,7 +56,7 @@ import numbers
 
 import numpy as np
 
-from ..catalogue_types import check_int
+from ..catalogue.entries import check_int
 from ._checks import _int
 
 __all__ = ["corrected", "fit_loglog", "mean_ci", "pass_variance", "ratio_ci", "relmse_noise"]

@@ -143,7 +143,7 @@ def _main(argv: list[str] | None, ran: dict) -> int:
             warnings.showwarning = _show_warning
             return args.func(args)
     except (ValueError, TypeError, OSError, BackendUnavailable, TasksLost) as exc:  # ClusterUnavailable: ValueError
-        # OSError: an output that cannot be written (pyoa.atomic names the
+        # OSError: an output that cannot be written (pyoa.util.atomic names the
         # user's path), a missing input file; a one-line message, not a traceback
         ap.exit(2, f"pyoa {args.command}: error: {exc}\n")
     except MemoryError as exc:
@@ -155,7 +155,7 @@ def _main(argv: list[str] | None, ran: dict) -> int:
                    f"${ENV_MAX_BYTES} to the memory available so that such a job is refused before it "
                    "starts\n")
     except KeyboardInterrupt:
-        # Ctrl-C, or SIGINT from a job manager: every output is written atomically (pyoa.atomic), so none is
+        # Ctrl-C, or SIGINT from a job manager: every output is written atomically (pyoa.util.atomic), so none is
         # left half-written; a command's ``interrupted(args)`` says what it kept. 130 = 128 + SIGINT, as a shell
         # reports a process that SIGINT ended.
         kept = getattr(args, "interrupted", None)

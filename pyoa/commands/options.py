@@ -9,9 +9,9 @@ from __future__ import annotations
 import os
 import sys
 
-from ..atomic import check_writable
+from ..util.atomic import check_writable
 from ..catalogue import get, nearest_spp
-from ..catalogue_types import check_int
+from ..catalogue.entries import check_int
 from ..plots import FIGURE_WIDTH
 from ..plots import MAX_SIZE as MAX_FIGURE_WIDTH
 from ..plots import MIN_SIZE as MIN_FIGURE_WIDTH

@@ -10,11 +10,11 @@ from pathlib import Path
 
 from .. import catalogue
 from ..analysis.statistics import corrected, mean_ci, ratio_ci, relmse_noise
-from ..atomic import atomic_path, check_not_inputs
-from ..catalogue_types import MAX_SPP, MAX_UINT32, check_int
+from ..util.atomic import atomic_path, check_not_inputs
+from ..catalogue.entries import MAX_SPP, MAX_UINT32, check_int
 from ..cluster import add_arguments as add_engine_arguments
 from ..cluster import check_engine, engine
-from ..units import format_interval, format_rate, format_ratio
+from ..util.units import format_interval, format_rate, format_ratio
 from .options import DEFAULT_SPP, add_sampling_options, resolve_spp
 from ..render.image import (
     EXR,
@@ -153,7 +153,7 @@ def cmd_render(args) -> int:
 
 def _reference_inputs(reference) -> list[tuple[str, object]]:
     """The files a command given ``--reference`` reads: the image and its variance file
-    (:func:`~pyoa.render.reference.variance_path`), as :func:`pyoa.atomic.check_not_inputs` takes them."""
+    (:func:`~pyoa.render.reference.variance_path`), as :func:`pyoa.util.atomic.check_not_inputs` takes them."""
     if not reference:
         return []
     return [("--reference", reference), ("--reference's variance file", variance_path(reference))]

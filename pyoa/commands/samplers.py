@@ -9,12 +9,12 @@ import time
 import numpy as np
 
 from .. import OFFSETS, backends, sampler, samplers, valid_spp
-from ..atomic import atomic_path
+from ..util.atomic import atomic_path
 from ..catalogue import get
-from ..catalogue_types import MAX_DIMS, MAX_UINT32, SppChoice
+from ..catalogue.entries import MAX_DIMS, MAX_UINT32, SppChoice
 from ..plots import FIGURE_WIDTH
 from ..samplers import trial_options
-from ..units import format_rate
+from ..util.units import format_rate
 from .options import (DEFAULT_SPP, add_sampling_options, check_out, deprecated, figure_width, int_option,
                       resolve_spp, suffix)
 
@@ -185,7 +185,7 @@ def cmd_spectrum(args) -> int:
 
 
 def cmd_backends(args) -> int:
-    from ..hostcpu import host_cpu
+    from ..util.hostcpu import host_cpu
 
     report = backends()  # first: a bad $PYOA_BACKEND is refused before anything is printed
     print(f"CPU: {host_cpu().describe()}")

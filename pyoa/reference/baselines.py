@@ -34,7 +34,7 @@ References
 
 from __future__ import annotations
 
-from .. import sequences
+from ..tables import sequences
 from .floats import f32, jitter_value, sample_value
 from .hashes import MASK, hash_pair, mix32, permute, randfloat
 
@@ -97,7 +97,7 @@ def owen_scramble(x: int, seed: int) -> int:
 
 def sobol_bits(g: int, dim: int) -> int:
     """The 32-bit unscrambled Sobol coordinate ``dim`` of index ``g``: the XOR
-    of the direction numbers :func:`pyoa.sequences.sobol_matrices` over the
+    of the direction numbers :func:`pyoa.tables.sequences.sobol_matrices` over the
     set bits of ``g``."""
     v = sequences.sobol_matrices()[dim]
     x = 0
@@ -333,7 +333,7 @@ def halton(i: int, j: int, p: int) -> float:
 
 def sobol(i: int, j: int, p: int) -> float:
     """Owen-scrambled Sobol sequence in up to 21201 dimensions (Joe-Kuo
-    direction numbers, :mod:`pyoa.sequences`), in SciPy's Gray-code order.
+    direction numbers, :mod:`pyoa.tables.sequences`), in SciPy's Gray-code order.
 
     Sample ``i`` is the Sobol point of index ``g = i ^ (i >> 1)``, the order
     :class:`scipy.stats.qmc.Sobol` produces (``p == 0`` equals

@@ -79,7 +79,7 @@ from __future__ import annotations
 
 import functools
 
-from .. import sequences
+from ..tables import sequences
 from .baselines import UNIT24, derived_seed
 from .hashes import MASK, block_seed, hash_pair, permute
 
@@ -98,7 +98,7 @@ MAX_INDEX = 1 << 24
 @functools.cache
 def bases() -> tuple[int, ...]:
     """Every valid base: the primes up to :data:`MAX_BASE`, in increasing order
-    (from :func:`pyoa.sequences.primes`)."""
+    (from :func:`pyoa.tables.sequences.primes`)."""
     return tuple(int(q) for q in sequences.primes() if q <= MAX_BASE)
 
 

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-from .. import gf
+from ..tables import gf
 from .floats import f32, jitter_value, sample_value
 from .hashes import MASK, dimension_seeds, locate, permute, randfloat
 
@@ -75,7 +75,7 @@ class Geometry(NamedTuple):
     rows, ``B`` columns per block, ``s`` symbols, ``M = N / s`` sub-strata.
     Each construction's ``*_geometry`` function below is its only definition:
     the NumPy and Dr.Jit implementations and the catalogue
-    (:mod:`pyoa.constructions`, whose ``Params`` carry ``block_dims = B`` and
+    (:mod:`pyoa.catalogue.constructions`, whose ``Params`` carry ``block_dims = B`` and
     ``M`` to the OpenCL kernels) read it from here."""
 
     N: int
@@ -152,7 +152,7 @@ def bose(i: int, j: int, s: int, p: int, offset: str = "cmj", jitter: float = 1.
     j : int
         Dimension, any ``j >= 0`` (blocks of ``s + 1``).
     s : int
-        Strata per axis: a prime, or a prime power up to 256 (:mod:`pyoa.gf`).
+        Strata per axis: a prime, or a prime power up to 256 (:mod:`pyoa.tables.gf`).
     p : int
         Array seed (uint32); 0 is the canonical array.
     offset : {"cmj", "mj", "j", "centered"}
@@ -276,7 +276,7 @@ def addelman_kempthorne(i: int, j: int, q: int, p: int, offset: str = "cmj", jit
     power, ``N = 2 q**2``, ``2q + 1`` columns per block.
 
     Row ``i = h q**2 + x q + y`` (half ``h``, ``x, y`` in GF(q)); with the
-    constants ``kappa, b, k, c`` of :func:`pyoa.gf.ak_constants`:
+    constants ``kappa, b, k, c`` of :func:`pyoa.tables.gf.ak_constants`:
 
     ============  =======================  ==================================
     column        first half (h = 0)       second half (h = 1)

@@ -5,7 +5,7 @@ The sampler
 ``pmj02`` is padded like :func:`~.baselines.sobol02`: dimensions ``(0, 1),
 (2, 3), ...`` are pairs ``b = j >> 1``, coordinate ``c = j & 1``, and every
 pair of every pixel reads its own randomized copy of one of ``SETS = 16``
-precomputed pmj02 sequences of ``POINTS = 2**16`` points (:mod:`pyoa.pmj02_tables`)::
+precomputed pmj02 sequences of ``POINTS = 2**16`` points (:mod:`pyoa.tables.pmj02`)::
 
     h     = derived_seed(p, b, PMJ02_KEY)                    # 0 when p == 0
     set   = h >> 28                                          # one of the 16 sets
@@ -58,7 +58,7 @@ References
 
 from __future__ import annotations
 
-from ..pmj02_tables import tables
+from ..tables.pmj02 import tables
 from .baselines import UNIT24, derived_seed, owen_scramble
 from .hashes import MASK
 from .pmj02_build import POINTS, POINTS_LOG2
@@ -71,7 +71,7 @@ def pmj02(i: int, j: int, log2n: int, p: int) -> float:
     """Padded pmj02: value ``j`` of sample ``i`` of the point set with seed ``p``.
 
     With ``b = j >> 1``, ``c = j & 1`` and the table ``T`` of
-    :func:`pyoa.pmj02_tables.tables`::
+    :func:`pyoa.tables.pmj02.tables`::
 
         h = derived_seed(p, b, PMJ02_KEY)
         g = owen_scramble(i, derived_seed(h, 0, PMJ02_SHIFT_KEY)) mod 2**16

@@ -3,7 +3,7 @@
 The sampler that reads these tables, its randomization and the argument
 that every prefix and aligned block stays a net are in :mod:`pyoa.reference.pmj02`;
 this module is the construction alone, so that the fast builder and cache of
-:mod:`pyoa.pmj02_tables` (and ``kernels/include/pyoa/pmj02_build.h``) can
+:mod:`pyoa.tables.pmj02` (and ``kernels/include/pyoa/pmj02_build.h``) can
 follow it without importing the sampler that reads their tables.
 
 The table builder
@@ -204,7 +204,7 @@ def check_points(points: int) -> None:
 
 def build_set(s: int, points: int = POINTS, stats: dict | None = None) -> list[tuple[int, int]]:
     """The first ``points`` points of set ``s`` as 24-bit integer pairs: the
-    readable reference of :func:`pyoa.pmj02_tables.build` (same bits).
+    readable reference of :func:`pyoa.tables.pmj02.build` (same bits).
 
     Parameters
     ----------

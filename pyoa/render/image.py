@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import atomic
-from ..atomic import atomic_path
+from ..util import atomic
+from ..util.atomic import atomic_path
 
 #: Output formats by extension (what pyoa writes: linear float EXR, 8-bit sRGB PNG).
 EXR, PNG = (".exr",), (".png",)
@@ -49,8 +49,8 @@ def check_output(path, option: str, suffixes: tuple[str, ...]) -> None:
 
 
 def check_writable(path, option: str) -> None:
-    """Refuse a ``path`` that :func:`pyoa.atomic.atomic_path` could not write
-    (see :func:`pyoa.atomic.check_writable`: a directory, a missing parent, a
+    """Refuse a ``path`` that :func:`pyoa.util.atomic.atomic_path` could not write
+    (see :func:`pyoa.util.atomic.check_writable`: a directory, a missing parent, a
     place where no file can be created), the message led by ``option``."""
     try:
         atomic.check_writable(path)

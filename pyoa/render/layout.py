@@ -24,7 +24,7 @@ the pixel, sample and depth).
 
 from __future__ import annotations
 
-from ..catalogue_types import MAX_DIMS
+from ..catalogue.entries import MAX_DIMS
 
 #: Longest path (segments) whose layout fits in a sampler's MAX_DIMS
 #: dimensions: pixel 2 + lens 2 + time 1 + 4 per vertex.

@@ -155,14 +155,14 @@ class ProgressiveResult:
 
 
 class _Bar:
-    """The progress bar of a progressive render (:func:`pyoa.progress.bar`): one bar for the whole render,
+    """The progress bar of a progressive render (:func:`pyoa.util.progress.bar`): one bar for the whole render,
     in whole samples per pixel. A batch of pixels adds a fraction of a sample, so the bar moves inside a
     block too (the last block holds half the samples), and shows the samples every pixel has. With a
     time budget, its time left is the budget's when that ends first (the render stops at the last
     doubling predicted to fit in it), not the time to ``spp``."""
 
     def __init__(self, name: str, smp, done: int, time_budget: float | None, t_start: float):
-        from ..progress import bar
+        from ..util.progress import bar
 
         self.exact, self.start, self.budget, self.t_start = float(done), done, time_budget, t_start
         self.bar = bar(total=smp.spp, initial=done, unit="spp", desc=f"{name} {smp.name}",

@@ -27,7 +27,7 @@ keeps any named attribute, as pbrt-v4 keeps its render metadata there too):
 ``pyoa:renderer``         :data:`~pyoa.render.integrator.RENDERER_VERSION`
 ``pyoa:version``          pyoa's version; ``pyoa:git`` the revision of a
                           source checkout (``+dirty`` with local changes)
-``pyoa:cpu``              the host CPU (:func:`pyoa.hostcpu.host_cpu`)
+``pyoa:cpu``              the host CPU (:func:`pyoa.util.hostcpu.host_cpu`)
 ``pyoa:command``          the command line, when written by the CLI
 ========================  =====================================================
 
@@ -73,7 +73,7 @@ def describe(scene, p, *, kind: str, command: str | None = None, shading: str | 
     ones (``samples``, ``passes``, ``pass_spp``) or replaces one (a
     reference's ``spp``). Values are str or int."""
     from .. import __version__
-    from ..hostcpu import host_cpu
+    from ..util.hostcpu import host_cpu
 
     ident = p.identity(scene)  # the render's identity (pyoa.render.render.Plan.identity), as header attributes
     meta = {"kind": kind, "scene": scene.name, "scene_file": str(scene.path), "scene_sha256": ident["scene"],

@@ -251,7 +251,7 @@ def render_reference(eng, scene, *, out, key: dict, settings: RenderSettings, se
     by the caller.
     ``metadata`` (:func:`pyoa.render.provenance.describe`) goes into both
     files' headers, with their kinds."""
-    from ..progress import bar as progress_bar
+    from ..util.progress import bar as progress_bar
     from .scene_source import source_of
 
     state = state_path(out)

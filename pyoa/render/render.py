@@ -24,10 +24,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import catalogue
-from ..catalogue_types import MAX_UINT32, check_choice
+from ..catalogue.entries import MAX_UINT32, check_choice
 from ..samplers import ENV_MAX_BYTES, default_max_bytes, parse_bytes
 from ..samplers import sampler as make_sampler
-from ..units import format_bytes
+from ..util.units import format_bytes
 from .camera import check_filter
 from .integrator import RENDERER_VERSION, Integrator, Stats
 from .layout import MAX_DEPTH, Layout
@@ -478,7 +478,7 @@ def render(scene, settings: RenderSettings | None = None, /, *, threads: int | N
         if outer is not None:
             outer.update(n * (p1 - p0) / (width * height))
         else:
-            from ..progress import bar as progress_bar
+            from ..util.progress import bar as progress_bar
 
             what = f"{spp} spp" if n == spp else f"samples {samples.start}..{samples.stop - 1} of {spp}"
             bar = progress_bar(total=n_pixels, initial=p1 - p0, unit="px", desc=f"{scene.name} {smp.name} {what}")

@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from ..catalogue_types import MAX_UINT32, check_int
+from ..catalogue.entries import MAX_UINT32, check_int
 
 #: Camera paths per batch (bounds the working set: ~1 KiB per path).
 BATCH_PATHS = 1 << 16

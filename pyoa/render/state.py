@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_path
+from ..util.atomic import atomic_path
 
 #: Most bytes of a state's key (JSON of a few settings).
 KEY_BYTES = 1 << 20

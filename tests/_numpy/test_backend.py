@@ -74,7 +74,7 @@ def test_later_blocks_on_the_table_path(monkeypatch, name, options, offset):
     computes the cells at its own rows. Dimensions that skip blocks (0, 30,
     31) and that interleave blocks (not a run of the request's dimensions)
     are both written where they belong."""
-    from pyoa.request import Request
+    from pyoa.catalogue.request import Request
 
     smp = pyoa.sampler(name, dims=40, seed=3, offset=offset, backend="numpy", **options)
     N, B = smp.spp, smp.block_dims

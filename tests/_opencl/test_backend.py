@@ -77,7 +77,7 @@ def test_table_path_splits_long_axes_and_partial_pixels(monkeypatch, opencl, off
     every chunk is a head, whole-pixel and tail rectangle, each on the table path.
     Same bits as NumPy, and as the reference at the seams. The table path is
     forced: ``auto`` takes the direct path on a GPU."""
-    from pyoa.request import Rect
+    from pyoa.catalogue.request import Rect
 
     n = 1369
     kw = dict(spp=n, dims=7, seed=5, offset=offset)

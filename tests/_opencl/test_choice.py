@@ -21,7 +21,7 @@ import pyoa
 from pyoa._opencl import choice, program
 from pyoa._opencl.device import NoUsableDevice, candidates, list_devices
 from pyoa.backends import BackendUnavailable, fallback_message
-from pyoa.hostcpu import host_cpu
+from pyoa.util.hostcpu import host_cpu
 
 pytestmark = pytest.mark.opencl
 

@@ -204,8 +204,8 @@ def field_args(opencl):
 @pytest.mark.parametrize("q", [4, 8, 9, 27, 125, 256, 2, 13, 251, 4093])
 def test_gf_add_mul_match_pyoa_gf(harness, field_args, q):
     """pyoa/gf.h: table lookups for prime powers, mod q for primes, on every pair
-    (or many random ones), against pyoa.gf's scalar definition."""
-    from pyoa import gf
+    (or many random ones), against pyoa.tables.gf's scalar definition."""
+    from pyoa.tables import gf
 
     if q * q <= 70000:
         a, b = (x.astype(U32) for x in np.divmod(np.arange(q * q), q))

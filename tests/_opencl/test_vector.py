@@ -16,7 +16,7 @@ import pytest
 
 from pyoa import reference as ref
 from pyoa.reference import hashes as ref_hashes
-from pyoa.request import MAX_ARRAY_CELLS
+from pyoa.catalogue.request import MAX_ARRAY_CELLS
 from tests.helpers import U32_MAX, assert_same_bits, make
 
 pytestmark = pytest.mark.opencl

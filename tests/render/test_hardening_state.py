@@ -43,7 +43,7 @@ from pyoa.render.reference import Passes, reference_key
 from pyoa.render.render import SCENE_TRIANGLE_BYTES, plan, render
 from pyoa.render.scene import MESH_FILE_FACTOR, MESH_KEPT_BYTES, MESH_TRIANGLE_BYTES, SceneError, bundled, load
 from pyoa.render.state import write_state
-from pyoa.units import format_bytes
+from pyoa.util.units import format_bytes
 
 from .limits import python_child
 from .test_hardening_cli import OLD, refused

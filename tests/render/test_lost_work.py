@@ -5,7 +5,7 @@
   given as an image, a scene or a mesh is refused at once, never waited on.
 * No command writes a file it reads: an output that is an input, in any
   spelling (``./``, ``sub/../``, a symlink, a hard link), is refused before
-  any rendering (:func:`pyoa.atomic.check_not_inputs`).
+  any rendering (:func:`pyoa.util.atomic.check_not_inputs`).
 * A variance file is tied to its reference by the digest of the reference's
   pixels in its header; one of another image is refused, never used.
 * A truncated reference says so, with OpenImageIO's reason.

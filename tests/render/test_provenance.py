@@ -13,7 +13,7 @@ import pytest
 
 import pyoa
 from pyoa.commands import main
-from pyoa.hostcpu import host_cpu
+from pyoa.util.hostcpu import host_cpu
 from pyoa.render import image, provenance
 from pyoa.render.image import read_image, write_exr
 from pyoa.render.integrator import RENDERER_VERSION

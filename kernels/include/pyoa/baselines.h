@@ -4,7 +4,7 @@
  * sobol, and the helpers zsobol.h and pmj02.h share. Values of random,
  * sobol02, halton and sobol are k * 2^-24 with k a 24-bit integer: exact in
  * float, no rounding. Each pyoa_sample_<name> is named by its catalogue
- * entry (pyoa/baselines.py `kernel`). */
+ * entry (pyoa/catalogue/baselines.py `kernel`). */
 #ifndef PYOA_BASELINES_H
 #define PYOA_BASELINES_H
 

@@ -1,8 +1,8 @@
 /* pyoa/counts.h: the catalogue's sample counts in C. Which names pyoa has,
  * which sample counts each sampler accepts and what parameters a count
  * means (s, strength t, block_dims, M), or why a count is refused, with
- * the nearest valid counts on both sides: pyoa.catalogue, pyoa.constructions,
- * pyoa.baselines, pyoa.progressive and the checks of pyoa.Sampler, mirrored
+ * the nearest valid counts on both sides: pyoa.catalogue, pyoa.catalogue.constructions,
+ * pyoa.catalogue.baselines, pyoa.catalogue.faure and the checks of pyoa.Sampler, mirrored
  * so that the C API (pyoa/sampler.h) accepts exactly the requests the Python
  * API accepts, resolves them to the same parameters and refuses the others
  * with the same message (tests/test_c_counts.py compares the two).
@@ -61,7 +61,7 @@ enum {
 #include <stdio.h>
 #endif
 
-/* Largest samples per pixel (pyoa.catalogue_types.MAX_SPP = 2^24: every
+/* Largest samples per pixel (pyoa.catalogue.entries.MAX_SPP = 2^24: every
  * integer that becomes a float is exact in float32) and largest number of
  * dimensions (MAX_DIMS = 2^20). */
 #define PYOA_MAX_SPP 16777216u
@@ -72,10 +72,10 @@ enum {
  * Python API's None). */
 #define PYOA_OFFSET_NONE 4u
 
-/* Resolved parameters of one sampler: pyoa.catalogue_types.Params, plus
+/* Resolved parameters of one sampler: pyoa.catalogue.entries.Params, plus
  * the sampler's code and its count. As there:
  *   s           coarse strata per axis (an OA's order; faure's base; the
- *               comparison samplers' grids as pyoa.baselines documents);
+ *               comparison samplers' grids as pyoa.catalogue.baselines documents);
  *   strength    t (0 for random, halton and sobol; faure: the largest m
  *               with s^m <= spp);
  *   block_dims  dimensions per independently randomized block;

@@ -1,5 +1,5 @@
 /* pyoa/gf.h: arithmetic in the Galois field GF(q) of docs/spec.md section
- * 5.1 (pyoa/gf.py is the reference): mod q for a prime q, else lookups in
+ * 5.1 (pyoa/tables/gf.py is the reference): mod q for a prime q, else lookups in
  * the tables of pyoa/tables.h (pyoa_gf_fill), one buffer `gf` holding the
  * q*q addition table followed by the q*q multiplication table (uint16),
  * with `tabled` = 1. For a prime q, `gf` may be a 1-element placeholder and
@@ -29,12 +29,12 @@ PYOA_FN pyoa_u32 pyoa_gf_mul(pyoa_u32 a, pyoa_u32 b, pyoa_u32 q, PYOA_GLOBAL con
 /* Which orders pyoa has a field for, on the host (making a sampler,
  * filling its tables: pyoa/counts.h, pyoa/tables.h). */
 
-/* The largest composite prime power with GF tables (pyoa.gf.MAX_TABLE_Q). */
+/* The largest composite prime power with GF tables (pyoa.tables.gf.MAX_TABLE_Q). */
 #define PYOA_GF_MAX_TABLE_Q 256u
 
 /* The smallest prime factor p of q >= 2 and the exponent r with q = p^r;
  * returns p, or 0 (r = 0) when q is not a prime power (q < 2 included).
- * pyoa.gf.prime_power. Trial division up to sqrt(q) < 2^16. */
+ * pyoa.tables.gf.prime_power. Trial division up to sqrt(q) < 2^16. */
 PYOA_HOST_FN pyoa_u32 pyoa_gf_prime_power(pyoa_u32 q, pyoa_u32 *r)
 {
     pyoa_u32 p = q, d, e = 0;
@@ -56,7 +56,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_gf_prime_power(pyoa_u32 q, pyoa_u32 *r)
 }
 
 /* Whether pyoa has GF(q): q prime, or a prime power up to 256
- * (pyoa.gf.is_supported). */
+ * (pyoa.tables.gf.is_supported). */
 PYOA_HOST_FN int pyoa_gf_is_supported(pyoa_u32 q)
 {
     pyoa_u32 r;

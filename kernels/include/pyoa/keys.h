@@ -32,7 +32,7 @@
 #define PYOA_SUBY_KEY 0x02e5be93u
 #define PYOA_ZSOBOL_KEY 0xb5297a4du
 
-/* The catalogue's codes (pyoa.catalogue: each sampler's `code`; pyoa.catalogue_types.OFFSET_CODES). */
+/* The catalogue's codes (pyoa.catalogue: each sampler's `code`; pyoa.catalogue.entries.OFFSET_CODES). */
 #define PYOA_SAMPLER_BOSE 0u
 #define PYOA_SAMPLER_BUSH 2u
 #define PYOA_SAMPLER_CMJND 1u

@@ -8,7 +8,7 @@
  * - a construction's cell of (row, column): the entry A_ij, the sub-stratum
  *   index u and the 'j' offset's cell key ck (the pyoa_<name>_cell
  *   functions, sections 5.3-5.7, the only part a construction supplies; the
- *   catalogue's entries name them, pyoa/constructions.py `kernel`);
+ *   catalogue's entries name them, pyoa/catalogue/constructions.py `kernel`);
  * - the common tail (section 5.2, pyoa_oa_tail): the column's seeds, the
  *   permuted stratum, the offset's sub-stratum, the jitter and the float.
  * pyoa_oa_value puts the three together for a construction's catalogue code

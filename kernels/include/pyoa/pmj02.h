@@ -1,7 +1,7 @@
 /* pyoa/pmj02.h: pmj02, padded progressive multi-jittered (0,2) sequences
  * (docs/spec.md section 5.8; pyoa/reference/pmj02.py holds the mathematics
  * and references). Values are k * 2^-24 with k a 24-bit integer: exact in
- * float, no rounding. The table is pyoa.pmj02_tables.tables(), built in C by
+ * float, no rounding. The table is pyoa.tables.pmj02.tables(), built in C by
  * pyoa/pmj02_build.h. */
 #ifndef PYOA_PMJ02_H
 #define PYOA_PMJ02_H
@@ -11,7 +11,7 @@
 #include "hashes.h"
 #include "keys.h"
 
-/* The table's layout, pyoa.pmj02_tables.SETS and .POINTS (tests check that
+/* The table's layout, pyoa.tables.pmj02.SETS and .POINTS (tests check that
  * these equal them): 16 sets because h >> 28 picks the set. */
 #define PYOA_PMJ02_SETS 16u
 #define PYOA_PMJ02_POINTS 65536u

@@ -1,10 +1,10 @@
 /* pyoa/pmj02_build.h: the pmj02 table builder (host only), bit for bit
- * pyoa.pmj02_tables.tables(): 16 progressive multi-jittered (0,2) sequences
+ * pyoa.tables.pmj02.tables(): 16 progressive multi-jittered (0,2) sequences
  * of 2^16 points, coordinates 24-bit integers k (the value is k * 2^-24),
  * uint32 of shape (set, point, coordinate) = (16, 65536, 2), row-major.
  *
  * Algorithm (pyoa/reference/pmj02.py gives the full argument; build_set
- * there is the readable version, pyoa/pmj02_tables.py the numba one; this
+ * there is the readable version, pyoa/tables/pmj02.py the numba one; this
  * file makes the same draws for the same choices):
  * - Christensen, Kensler and Kilpatrick's pmj02 (EGSR 2018): after n = 2^m
  *   points the set is a (0,m,2)-net; the next n points go into subquadrants
@@ -282,7 +282,7 @@ PYOA_HOST_FN int pyoa_pmj02_fill_set(pyoa_u32 set, pyoa_u32 points, pyoa_u32 *ou
     return pyoa_pmj02_build(pyoa_pmj02_set_seed(set), points, out, &o);
 }
 
-/* The whole table, pyoa.pmj02_tables.tables(), into out
+/* The whole table, pyoa.tables.pmj02.tables(), into out
  * (pyoa_pmj02_table_entries() words, row-major set, point, coordinate), with
  * no other memory: set s keeps its occupancy in the top bytes of the first
  * 17 * 2^16 / 8 words of set 8 (s < 8) or of set 0 (s >= 8), never its own

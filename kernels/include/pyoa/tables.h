@@ -30,7 +30,7 @@
 #include "gf.h"
 #include "sobol_data.h"
 
-/* Halton's bases are the primes below 2^16 (pyoa.sequences.HALTON_MAX_BASE),
+/* Halton's bases are the primes below 2^16 (pyoa.tables.sequences.HALTON_MAX_BASE),
  * 6542 of them (HALTON_MAX_DIMS). */
 #define PYOA_HALTON_MAX_BASE 65536u
 #define PYOA_HALTON_MAX_DIMS 6542u
@@ -38,7 +38,7 @@
 #if !defined(__OPENCL_VERSION__)
 
 /* ======================================================================== GF(q)
- * docs/spec.md section 5.1 (pyoa/gf.py, its definition): q = p^r; an element
+ * docs/spec.md section 5.1 (pyoa/tables/gf.py, its definition): q = p^r; an element
  * is its code, the base-p digits of its polynomial's coefficients, constant
  * term least significant. Addition adds digits mod p; multiplication
  * multiplies the polynomials and reduces modulo the first monic irreducible
@@ -90,7 +90,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_tables_code(const pyoa_u32 *digits, pyoa_u32 p, pyoa_
 
 /* Whether the monic polynomial g of degree dg (g[0 .. dg-1], g[dg] = 1)
  * divides the monic f of degree df over GF(p): schoolbook long division,
- * then the remainder's dg coefficients (pyoa.gf._polymod_is_zero). */
+ * then the remainder's dg coefficients (pyoa.tables.gf._polymod_is_zero). */
 PYOA_HOST_FN int pyoa_tables_divides(const pyoa_u32 *g, pyoa_u32 dg, const pyoa_u32 *f, pyoa_u32 df, pyoa_u32 p)
 {
     pyoa_u32 a[PYOA_TABLES_MAX_R + 1], k, m;
@@ -111,9 +111,9 @@ PYOA_HOST_FN int pyoa_tables_divides(const pyoa_u32 *g, pyoa_u32 dg, const pyoa_
 
 /* GF(q)'s modulus, for q = p^r with r >= 2: the first monic irreducible
  * polynomial of degree r over GF(p) in the order of the code of its lower
- * coefficients (pyoa.gf.modulus; the table of docs/spec.md section 5.1).
+ * coefficients (pyoa.tables.gf.modulus; the table of docs/spec.md section 5.1).
  * Irreducible: no monic factor of degree 1 .. r/2. Writes f[0 .. r-1]; the
- * search is the definition's, so nothing here can drift from pyoa.gf (a
+ * search is the definition's, so nothing here can drift from pyoa.tables.gf (a
  * stored table of moduli would be one more thing to keep in step), and it
  * costs at most a few thousand trial divisions of degree <= 8 for q <= 256. */
 PYOA_HOST_FN void pyoa_tables_find_modulus(pyoa_u32 p, pyoa_u32 r, pyoa_u32 *f)
@@ -151,7 +151,7 @@ PYOA_HOST_FN int pyoa_tables_field_init(pyoa_tables_field *F, pyoa_u32 q)
 }
 
 /* The code of the lower coefficients of GF(q)'s modulus, sum f_k p^k for
- * k < r (f_r = 1 is implied): 0 for prime q, whose modulus is x (pyoa.gf.modulus
+ * k < r (f_r = 1 is implied): 0 for prime q, whose modulus is x (pyoa.tables.gf.modulus
  * gives (0, 1)); 0 also for a q that is not a prime power. */
 PYOA_HOST_FN pyoa_u32 pyoa_gf_modulus(pyoa_u32 q)
 {
@@ -160,7 +160,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_gf_modulus(pyoa_u32 q)
     return pyoa_tables_code(F.f, F.p, F.r);
 }
 
-/* a + b in GF(q): digit-wise mod p (pyoa.gf.add). */
+/* a + b in GF(q): digit-wise mod p (pyoa.tables.gf.add). */
 PYOA_HOST_FN pyoa_u32 pyoa_tables_add(const pyoa_tables_field *F, pyoa_u32 a, pyoa_u32 b)
 {
     pyoa_u32 da[PYOA_TABLES_MAX_R], db[PYOA_TABLES_MAX_R], k;
@@ -172,7 +172,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_tables_add(const pyoa_tables_field *F, pyoa_u32 a, py
 }
 
 /* a * b in GF(q): the polynomial product, its terms x^k for k >= r replaced,
- * from the top, by x^(k-r) (x^r - f) (pyoa.gf.mul). */
+ * from the top, by x^(k-r) (x^r - f) (pyoa.tables.gf.mul). */
 PYOA_HOST_FN pyoa_u32 pyoa_tables_mul(const pyoa_tables_field *F, pyoa_u32 a, pyoa_u32 b)
 {
     pyoa_u32 da[PYOA_TABLES_MAX_R], db[PYOA_TABLES_MAX_R], prod[2 * PYOA_TABLES_MAX_R], k, m;
@@ -205,7 +205,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_tables_pow(const pyoa_tables_field *F, pyoa_u32 a, py
 }
 
 /* The inverse of a != 0: a^(q-2), the multiplicative group having order
- * q - 1 (pyoa.gf.inverse). */
+ * q - 1 (pyoa.tables.gf.inverse). */
 PYOA_HOST_FN pyoa_u32 pyoa_tables_inverse(const pyoa_tables_field *F, pyoa_u32 a)
 {
     return pyoa_tables_pow(F, a, F->q - 2u);
@@ -213,7 +213,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_tables_inverse(const pyoa_tables_field *F, pyoa_u32 a
 
 /* GF(q)'s table buffer, pyoa_gf_table_entries(q) uint16 entries: when
  * pyoa_gf_tabled(q), out[a q + b] = a + b and out[q^2 + a q + b] = a b for
- * a, b < q (the codes of pyoa.gf.tables(q), addition then multiplication,
+ * a, b < q (the codes of pyoa.tables.gf.tables(q), addition then multiplication,
  * as pyoa/_opencl/backend.py's _field_tables concatenates them); otherwise
  * out[0] = 0, the placeholder. At most 2 * 65536 entries (q = 256), each
  * computed from the definition: a few milliseconds. */
@@ -235,7 +235,7 @@ PYOA_HOST_FN void pyoa_gf_fill(pyoa_u32 q, pyoa_u16 *out)
 }
 
 /* ========================================================= Addelman-Kempthorne
- * docs/spec.md section 5.6 (pyoa.gf.ak_constants; Addelman and Kempthorne
+ * docs/spec.md section 5.6 (pyoa.tables.gf.ak_constants; Addelman and Kempthorne
  * 1961, in the form of Hedayat, Sloane and Stufken, "Orthogonal Arrays",
  * 1999, section 3.4), q an odd prime power, all arithmetic in GF(q):
  *   kappa = the non-square with the smallest code,
@@ -256,7 +256,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_ak_entries(pyoa_u32 q)
  * definition (no table: prime q has none), about 60 multiplications per m.
  * kappa by Euler's criterion: x != 0 is a square of GF(q), q odd, iff
  * x^((q-1)/2) = 1 (the multiplicative group is cyclic of even order q - 1),
- * so the first x failing it is pyoa.gf's smallest code outside the squares. */
+ * so the first x failing it is pyoa.tables.gf's smallest code outside the squares. */
 PYOA_HOST_FN void pyoa_ak_fill(pyoa_u32 q, pyoa_u32 *out)
 {
     pyoa_tables_field F;
@@ -280,7 +280,7 @@ PYOA_HOST_FN void pyoa_ak_fill(pyoa_u32 q, pyoa_u32 *out)
 
 /* ==================================================================== Halton
  * docs/spec.md section 5.8: dimension j has base the j-th prime (2 for
- * j = 0), primes below 2^16 only (pyoa.sequences.primes). */
+ * j = 0), primes below 2^16 only (pyoa.tables.sequences.primes). */
 
 /* 6542: the primes below 2^16. */
 PYOA_HOST_FN pyoa_u32 pyoa_halton_entries(void)
@@ -309,7 +309,7 @@ PYOA_HOST_FN void pyoa_halton_fill(pyoa_u32 *out)
 }
 
 /* ===================================================================== Sobol
- * docs/spec.md section 5.8 (pyoa.sequences.sobol_matrices; Bratley and
+ * docs/spec.md section 5.8 (pyoa.tables.sequences.sobol_matrices; Bratley and
  * Fox, ACM TOMS 14(1), 88-100, 1988, on the Joe-Kuo parameters of
  * sobol_data.h): dimension 0 has m_k = 1 for all k; dimension d >= 1, with
  * poly[d] of degree s = bit_length - 1, has m_0 .. m_(s-1) its initial
@@ -333,7 +333,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_sobol_entries(pyoa_u32 dims)
 }
 
 /* out[32 d + k] = V[d][k] for d < dims, k < 32: the first dims rows of
- * pyoa.sequences.sobol_matrices(), row-major. No bit is lost in uint32:
+ * pyoa.tables.sequences.sobol_matrices(), row-major. No bit is lost in uint32:
  * the initial m_k are below 2^(k+1) (k from 0), and every term of the
  * recurrence for m_k is then below 2^(k+1) too, so m_k << (31 - k) < 2^32.
  * All 21201 dimensions take a few milliseconds. */

@@ -79,7 +79,7 @@ PYOA_FN pyoa_u32 pyoa_zsobol_index(pyoa_u32 i, pyoa_u32 log2n, pyoa_u32 log2res,
 /* The first two Sobol' dimensions without a table: dimension 0's direction
  * numbers are v_k = 2^(31-k) (bit reversal), dimension 1's are
  * v_0 = 2^31, v_(k+1) = v_k ^ (v_k >> 1) (Pascal's triangle mod 2): rows 0
- * and 1 of pyoa.sequences.sobol_matrices(). */
+ * and 1 of pyoa.tables.sequences.sobol_matrices(). */
 PYOA_FN pyoa_u32 pyoa_zsobol_sobol_bits(pyoa_u32 g, pyoa_u32 c)
 {
     pyoa_u32 x = 0u;

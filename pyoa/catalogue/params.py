@@ -1,6 +1,6 @@
 """The resolved parameters of a sampler: one type per family of the catalogue.
 
-A catalogue entry (:mod:`pyoa.catalogue_types`) turns a requested count into
+A catalogue entry (:mod:`pyoa.catalogue.entries`) turns a requested count into
 one of these, and every backend reads it. Each field means one thing in
 every entry of its type:
 
@@ -19,7 +19,7 @@ every entry of its type:
 
 What a listing shows of them (the public :class:`pyoa.SppChoice` and the
 sampler attributes ``s``, ``strength`` and ``block_dims``) is the entry's
-:meth:`~pyoa.catalogue_types.Construction.choice`. The types are frozen and
+:meth:`~pyoa.catalogue.entries.Construction.choice`. The types are frozen and
 compare by type and value: the backends key their uploads on them.
 """
 

@@ -5,7 +5,7 @@ an instance of a :class:`Construction` subclass, registered once with
 :func:`register`. The entry holds what every backend, test and error message
 needs to know about the sampler before a single value is computed (its valid
 sample counts and the parameters they mean, of its family's type in
-:mod:`pyoa.params`) and names its three implementations, which give the same
+:mod:`pyoa.catalogue.params`) and names its three implementations, which give the same
 bits:
 
 ``reference``
@@ -25,9 +25,9 @@ backends, the name lists and the conformance and
 property suites (``tests/test_catalogue.py``) are built from the registry.
 
 This module imports only the seed hashes below it (:mod:`pyoa.reference`,
-:mod:`pyoa.hashes`); the entries (:mod:`pyoa.constructions`,
-:mod:`pyoa.baselines`, :mod:`pyoa.progressive`) import it and
-:mod:`pyoa.params`, and :mod:`pyoa.catalogue` imports them, so the
+:mod:`pyoa.hashes`); the entries (:mod:`pyoa.catalogue.constructions`,
+:mod:`pyoa.catalogue.baselines`, :mod:`pyoa.catalogue.faure`) import it and
+:mod:`pyoa.catalogue.params`, and :mod:`pyoa.catalogue` imports them, so the
 dependencies run one way. Behaviour that depends on an entry's family is a
 method of that family's class (:class:`Construction`); :data:`FAMILIES`
 groups the entries for listing only.
@@ -50,9 +50,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .hashes import pixel_seed as _numpy_pixel_seed
-from .reference.hashes import pixel_seed as _reference_pixel_seed
-from .reference.oa import OFFSETS
+from ..hashes import pixel_seed as _numpy_pixel_seed
+from ..reference.hashes import pixel_seed as _reference_pixel_seed
+from ..reference.oa import OFFSETS
 
 #: Kernel codes of the offset styles of docs/spec.md section 4 (OFFSETS,
 #: defined with their mathematics in pyoa.reference.oa).
@@ -230,12 +230,12 @@ class Construction:
     """Base class of the catalogue's entries (see the module docstring).
 
     Each family has its own subclass, which the entries derive from:
-    :class:`pyoa.constructions._OA` (the orthogonal arrays, family
-    ``"oa"``), :class:`pyoa.baselines.Baseline` (the comparison samplers,
-    ``"baseline"``) and :class:`pyoa.progressive.Faure`
+    :class:`pyoa.catalogue.constructions._OA` (the orthogonal arrays, family
+    ``"oa"``), :class:`pyoa.catalogue.baselines.Baseline` (the comparison samplers,
+    ``"baseline"``) and :class:`pyoa.catalogue.faure.Faure`
     (``"progressive"``). A family's subclass answers, as methods, every
     question whose answer depends on the family (the parameter type of
-    :mod:`pyoa.params` it resolves to, what a listing shows of it, its
+    :mod:`pyoa.catalogue.params` it resolves to, what a listing shows of it, its
     implementations' arguments, its OpenCL launch), so that no caller tests
     the family: :attr:`family` only groups the entries for listing.
 
@@ -402,7 +402,7 @@ class Construction:
 
     def solve(self, spp: int, dims: int | None, strength: int | None):
         """The parameters for ``spp`` samples (of the family's type,
-        :mod:`pyoa.params`), or None if it is not a valid count.
+        :mod:`pyoa.catalogue.params`), or None if it is not a valid count.
 
         Raises ValueError only for an invalid ``strength`` argument."""
         raise NotImplementedError
@@ -431,7 +431,7 @@ class CountRule(Construction):
     """Base of the entries whose valid counts are a rule of the count alone
     (every count, the powers of two or the squares, up to :attr:`max_spp`),
     which have no strength and no offset styles: the comparison samplers
-    (:mod:`pyoa.baselines`) and ``faure`` (:mod:`pyoa.progressive`).
+    (:mod:`pyoa.catalogue.baselines`) and ``faure`` (:mod:`pyoa.catalogue.faure`).
 
     Their implementations are called as ``function(i, j, *shape_args(params),
     *seed_args(...)[, jitter])`` (a jitter amount only where :attr:`jittered`),
@@ -448,7 +448,7 @@ class CountRule(Construction):
     why_not_progressive = "its grid is stratified only at the full count, not in its prefixes"
 
     def params(self, spp: int, dims: int | None):
-        """The parameters of a valid ``spp`` (of the entry's type, :mod:`pyoa.params`)."""
+        """The parameters of a valid ``spp`` (of the entry's type, :mod:`pyoa.catalogue.params`)."""
         raise NotImplementedError
 
     def _check(self, dims, strength):

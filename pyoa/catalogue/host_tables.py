@@ -6,16 +6,16 @@ vector path) split an OA value into what depends on the sample only (its cell
 dimension) only (the column key and the permutation shifts,
 :func:`column_keys`, :func:`table_keys`), and one gather per value. Both are
 computed here, on the host, once per rectangle of a request
-(:meth:`pyoa.request.Request.rectangles`).
+(:meth:`pyoa.catalogue.request.Request.rectangles`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ._numpy.oa import block_order_seed
-from .hashes import U32, block_seed, pixel_seed
-from .reference.hashes import STRATUM_KEY, SUBSTRATUM_KEY
+from .._numpy.oa import block_order_seed
+from ..hashes import U32, block_seed, pixel_seed
+from ..reference.hashes import STRATUM_KEY, SUBSTRATUM_KEY
 
 
 def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
@@ -30,7 +30,7 @@ def cells(req, k0: int, k1: int) -> tuple[np.ndarray, np.ndarray]:
     the pixel's permutations with it (both backends; the OpenCL kernel
     ``generate_cells`` reads exactly these arrays, and the vector path of
     :mod:`pyoa._opencl.vector` the same, padded), from the entry's NumPy
-    cell function (:meth:`pyoa.constructions._OA.cells`). ``u`` is 0 for the
+    cell function (:meth:`pyoa.catalogue.constructions._OA.cells`). ``u`` is 0 for the
     ``centered`` offset, which has no sub-stratum.
     """
     return _cells_at(req, req.samples[k0:k1])

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .catalogue_types import Construction
+from .entries import Construction
 from .params import FaureParams, OAParams, PointSetParams, SequenceParams
 
 #: Most cells (entries per array, each of 4 bytes, twice) the OpenCL table
@@ -87,7 +87,7 @@ class Request:
     @property
     def array_cells_fit(self) -> bool:
         """Whether the OpenCL table path may hold the cells of every row of
-        the array in each dimension's column (:func:`pyoa.host_tables.array_cells`),
+        the array in each dimension's column (:func:`pyoa.catalogue.host_tables.array_cells`),
         which it needs for dimensions past the first block: at most
         :data:`MAX_ARRAY_CELLS` entries. Larger requests take the direct path."""
         return not self.past_block0 or self.n_dims * self.params.N <= MAX_ARRAY_CELLS

@@ -27,15 +27,15 @@ import math
 import numbers
 from collections.abc import Sequence
 
-from . import pmj02_tables, sequences
-from ._numpy import baselines as _numpy_baselines
-from ._numpy import pmj02 as _numpy_pmj02
-from ._numpy import zsobol as _numpy_zsobol
-from .catalogue_types import MAX_SPP, Claim, CountRule, SppChoice, register
+from ..tables import pmj02 as pmj02_tables, sequences
+from .._numpy import baselines as _numpy_baselines
+from .._numpy import pmj02 as _numpy_pmj02
+from .._numpy import zsobol as _numpy_zsobol
+from .entries import MAX_SPP, Claim, CountRule, SppChoice, register
 from .params import PointSetParams, SequenceParams
-from .reference import baselines as _reference_baselines
-from .reference import pmj02 as _reference_pmj02
-from .reference import zsobol as _reference_zsobol
+from ..reference import baselines as _reference_baselines
+from ..reference import pmj02 as _reference_pmj02
+from ..reference import zsobol as _reference_zsobol
 
 
 #: The listed strata of the samplers of padded pairs, (s, strength, block_dims):
@@ -46,7 +46,7 @@ PAIRS = (2, 2, 2)
 class Baseline(CountRule):
     """The comparison samplers' family.
 
-    A sequence (:class:`pyoa.params.SequenceParams`) unless the entry is a
+    A sequence (:class:`pyoa.catalogue.params.SequenceParams`) unless the entry is a
     padded 2D grid (:class:`PointSet`). What a listing shows of one
     (:meth:`choice`): its :attr:`strata` and, for the powers of two, the
     exponent. They have no offset styles; only the samplers with ``jittered
@@ -84,7 +84,7 @@ class Baseline(CountRule):
 
 
 class PointSet(Baseline):
-    """The padded 2D grids (:class:`pyoa.params.PointSetParams`): every pair of
+    """The padded 2D grids (:class:`pyoa.catalogue.params.PointSetParams`): every pair of
     dimensions an ``a x c`` grid with one point per cell, stratified at the
     full count only. ``jitter`` scales the offset inside the cell."""
 
@@ -275,7 +275,7 @@ class Sobol(Baseline):
     """``sobol``: Owen-scrambled Sobol sequence, the paper's "Sobol".
 
     ``spp = 2**k``, up to 21201 dimensions with the Joe-Kuo direction
-    numbers SciPy ships (:mod:`pyoa.sequences`), in SciPy's Gray-code order,
+    numbers SciPy ships (:mod:`pyoa.tables.sequences`), in SciPy's Gray-code order,
     each dimension Owen-scrambled (Burley 2020) per pixel. Every power-of-two
     prefix is a (t,m,s)-net: each dimension stratified into ``2**k``
     intervals, dimensions 0 and 1 a (0,k,2)-net. Unscrambled (``p = 0``
@@ -378,7 +378,7 @@ class PMJ02(Baseline):
 
     ``spp = 2**k`` up to ``2**16``. Each pair of dimensions reads one of 16
     precomputed pmj02 sequences of ``2**16`` points (built once by pyoa's own
-    implementation of the paper's algorithm, cached: :mod:`pyoa.pmj02_tables`),
+    implementation of the paper's algorithm, cached: :mod:`pyoa.tables.pmj02`),
     chosen per (pixel, pair) by a hash and digitally shifted (XOR) by
     another: every power-of-two prefix of every pair is a (0,k,2)-net and each
     coordinate of it is stratified into ``2**k`` intervals, so the first ``n``

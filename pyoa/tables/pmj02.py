@@ -38,7 +38,7 @@ directory:
 2. else ``$XDG_CACHE_HOME/pyoa`` if ``XDG_CACHE_HOME`` is set,
 3. else ``~/.cache/pyoa``,
 
-written atomically (:mod:`pyoa.atomic`). A cached file is used only if its
+written atomically (:mod:`pyoa.util.atomic`). A cached file is used only if its
 shape, dtype and SHA-256 (:data:`TABLE_SHA256`, of the little-endian bytes)
 are right; otherwise a :class:`RuntimeWarning` says so and the table is
 rebuilt and rewritten. If the directory cannot be written the table is built
@@ -59,9 +59,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import atomic_path
-from .reference.hashes import MASK
-from .reference.pmj02_build import (
+from ..util.atomic import atomic_path
+from ..reference.hashes import MASK
+from ..reference.pmj02_build import (
     BITS,
     BUILD_SEED,
     PMJ02_DRAW_KEY,
@@ -103,7 +103,7 @@ def _kernels():
     :mod:`pyoa.reference.pmj02`, on int64 arrays."""
     import numba
 
-    from ._numba.hashes import hash_pair
+    from .._numba.hashes import hash_pair
 
     jit = numba.njit(cache=False)
 

@@ -1,9 +1,9 @@
 """The catalogue: every sampler pyoa has, registered once.
 
-:data:`SAMPLERS` maps each name to its entry (:mod:`pyoa.catalogue_types`):
-the orthogonal-array constructions of :mod:`pyoa.constructions`, then the
-comparison samplers of :mod:`pyoa.baselines` and the progressive orthogonal
-arrays of :mod:`pyoa.progressive`. Everything that lists, looks
+:data:`SAMPLERS` maps each name to its entry (:mod:`pyoa.catalogue.entries`):
+the orthogonal-array constructions of :mod:`pyoa.catalogue.constructions`, then the
+comparison samplers of :mod:`pyoa.catalogue.baselines` and the progressive orthogonal
+arrays of :mod:`pyoa.catalogue.faure`. Everything that lists, looks
 up or dispatches samplers reads it: :func:`pyoa.samplers`, the backends, the
 kernel dispatch (:func:`pyoa._opencl.program.dispatch_source`), the CLI and
 the test suites.
@@ -11,8 +11,8 @@ the test suites.
 
 from __future__ import annotations
 
-from . import baselines, constructions, progressive  # noqa: F401  (importing them registers their entries)
-from .catalogue_types import FAMILIES, MAX_DIMS, Construction, SppChoice, check_int
+from . import baselines, constructions, faure  # noqa: F401  (importing them registers their entries)
+from .entries import FAMILIES, MAX_DIMS, Construction, SppChoice, check_int
 
 #: The families of :attr:`Construction.family`, in the order the catalogue lists them.
 FAMILY_ORDER = ("oa", "baseline", "progressive")

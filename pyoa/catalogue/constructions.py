@@ -4,7 +4,7 @@ Bose, Bush, CMJND (Jarosz et al.'s high-dimensional CMJ), Addelman-Kempthorne
 and Bose-Bush: for each, which sample counts it accepts, which number of
 strata ``s`` and strength ``t`` a count means, how many dimensions one
 independently randomized block holds, and its three implementations (see
-:mod:`pyoa.catalogue_types`). The mathematics of each construction is in
+:mod:`pyoa.catalogue.entries`). The mathematics of each construction is in
 ``docs/spec.md`` section 5 and in the reference implementation
 :mod:`pyoa.reference.oa`.
 """
@@ -17,9 +17,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from . import gf
-from ._numpy import oa as _numpy_oa
-from .catalogue_types import (
+from ..tables import gf
+from .._numpy import oa as _numpy_oa
+from .entries import (
     MAX_SPP,
     OFFSET_CODES,
     OFFSETS,
@@ -32,7 +32,7 @@ from .catalogue_types import (
     register,
 )
 from .params import OAParams
-from .reference import oa as _reference_oa
+from ..reference import oa as _reference_oa
 
 
 def is_prime(n: int) -> bool:
@@ -79,7 +79,7 @@ def _power_candidates(spp: int, strengths, valid, choice) -> list[SppChoice]:
 
 
 class _OA(Construction):
-    """The orthogonal arrays' family: their parameters (:class:`pyoa.params.OAParams`),
+    """The orthogonal arrays' family: their parameters (:class:`pyoa.catalogue.params.OAParams`),
     kernel arguments and offset styles, the cells the table paths gather with,
     and the properties they guarantee."""
 
@@ -93,7 +93,7 @@ class _OA(Construction):
                            "are no smaller array (bose's first s samples share one stratum of dimension 0), so its "
                            "intermediate images would be poor")
     #: whether the array is computed in a Galois field (the backends then
-    #: need pyoa.gf's tables for prime-power orders); see field_order
+    #: need pyoa.tables.gf's tables for prime-power orders); see field_order
     uses_field = False
     #: whether the 'j' offset's cell key is Bose's partner cell
     #: ``u * s + A_ij + 1`` rather than ``i + 1`` (docs/spec.md section 4)
@@ -144,7 +144,7 @@ class _OA(Construction):
         """``(A_ij, u)`` of samples ``i`` in columns ``col < B``
         (NumPy arrays): the cell and its sub-stratum index, which do not depend
         on the pixel (the table paths of both backends compute them once per
-        rectangle, :mod:`pyoa.host_tables`)."""
+        rectangle, :mod:`pyoa.catalogue.host_tables`)."""
         raise NotImplementedError
 
     def claims(self, params, offset):

@@ -1,6 +1,6 @@
 """The catalogue's progressive orthogonal arrays: Owen-scrambled Faure (0, s)-sequences.
 
-The orthogonal arrays of :mod:`pyoa.constructions` are finite: ``bose`` is
+The orthogonal arrays of :mod:`pyoa.catalogue.constructions` are finite: ``bose`` is
 stratified at ``N = s**2`` and nowhere else, and a render cannot continue
 with more samples. A (0, s)-sequence in a prime base ``b`` (Faure 1982 [1]_)
 removes both limits: every aligned block of ``b**m`` consecutive samples is
@@ -26,10 +26,10 @@ from __future__ import annotations
 import math
 import numbers
 
-from ._numpy import faure as _numpy_faure
-from .catalogue_types import MAX_SPP, Claim, CountRule, SppChoice, register
+from .._numpy import faure as _numpy_faure
+from .entries import MAX_SPP, Claim, CountRule, SppChoice, register
 from .params import FaureParams
-from .reference import faure as _reference_faure
+from ..reference import faure as _reference_faure
 
 #: Largest base (the largest prime ``b`` with ``b**2 <= 2**24``).
 MAX_BASE = _reference_faure.MAX_BASE
