@@ -20,10 +20,10 @@ and below 1. ``p == 0`` (the unrandomized set) reads set 0 unshifted.
 with a constant maps every elementary interval ``[a 2**-u, (a+1) 2**-u) x
 [c 2**-v, (c+1) 2**-v)`` onto the interval of the same shape with ``a``
 and ``c`` XOR-ed by the shift's top ``u`` and ``v`` bits: a bijection of the
-intervals of each shape. So every property of the table that is stated in
+intervals of each shape [3]_. So every property of the table that is stated in
 elementary intervals survives, for every pixel: each power-of-two prefix
 ``[0, 2**k)`` is a (0,k,2)-net, hence each coordinate of it is stratified
-into ``2**k`` intervals. pbrt-v4's ``PMJ02BNSampler`` [5]_ instead adds a
+into ``2**k`` intervals. pbrt-v4's ``PMJ02BNSampler`` [2]_ instead adds a
 random offset modulo 1 (a Cranley-Patterson rotation, a toroidal shift):
 that moves interval boundaries, so a rotated (0,k,2)-net in general has two
 points in some elementary intervals and none in others; the rotation keeps
@@ -38,21 +38,16 @@ a pixel reads its set in its own order, so pairs are independent (padding).
 pbrt-v4 shuffles the index within the pixel's sample count, which keeps the
 full set but not its prefixes. ``log2n`` only bounds ``i``.
 
-The table and how it is built: :mod:`pyoa.reference.pmj02_build`.
+The table (Christensen, Kensler and Kilpatrick's pmj02 [1]_) and how it is
+built: :mod:`pyoa.reference.pmj02_build`.
 
 References
 ----------
 .. [1] P. Christensen, A. Kensler, C. Kilpatrick, "Progressive Multi-Jittered
    Sample Sequences", Computer Graphics Forum 37(4) (EGSR 2018), 21-33.
-.. [2] M. Pharr, "Efficient Generation of Points that Satisfy Two-Dimensional
-   Elementary Intervals", Journal of Computer Graphics Techniques 8(1), 2019.
-.. [3] A. Helmer, pmj-cpp (github.com/Andrew-Helmer/pmj-cpp),
-   ``GetSubQuadrantsSwapXOrY``, crediting S. Brown's pmj (github.com/sjb3d/pmj).
-.. [4] A. Helmer, P. Christensen, A. Kensler, "Stochastic Generation of (t, s)
-   Sample Sequences", EGSR 2021 (Symposium Track).
-.. [5] M. Pharr, W. Jakob, G. Humphreys, pbrt-v4 (``PMJ02BNSampler``), and
+.. [2] M. Pharr, W. Jakob, G. Humphreys, pbrt-v4 (``PMJ02BNSampler``), and
    "Physically Based Rendering", 4th ed., section 8.5.
-.. [6] J. Dick, F. Pillichshammer, "Digital Nets and Sequences", Cambridge
+.. [3] J. Dick, F. Pillichshammer, "Digital Nets and Sequences", Cambridge
    University Press, 2010 (digital shifts preserve (t,m,s)-nets).
 """
 

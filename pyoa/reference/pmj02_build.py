@@ -70,10 +70,6 @@ References
    ``GetSubQuadrantsSwapXOrY``, crediting S. Brown's pmj (github.com/sjb3d/pmj).
 .. [4] A. Helmer, P. Christensen, A. Kensler, "Stochastic Generation of (t, s)
    Sample Sequences", EGSR 2021 (Symposium Track).
-.. [5] M. Pharr, W. Jakob, G. Humphreys, pbrt-v4 (``PMJ02BNSampler``), and
-   "Physically Based Rendering", 4th ed., section 8.5.
-.. [6] J. Dick, F. Pillichshammer, "Digital Nets and Sequences", Cambridge
-   University Press, 2010 (digital shifts preserve (t,m,s)-nets).
 """
 
 from __future__ import annotations
