@@ -435,3 +435,17 @@ def test_rows_name_samplers_by_the_catalogues_own_lookup(d, made, monkeypatch):
     csv_path = d / "study.csv"
     csv_path.write_text(csv_path.read_text().replace(",bose,", ",oa-bose,"))
     assert study.read_rows(csv_path) == study.read_rows(made / "study.csv")
+
+
+def test_run_study_takes_a_settings_value_and_refuses_before_any_work(tmp_path):
+    """pyoa.study.run_study(StudySettings(...)) is the library form of ``pyoa study``: sequences are
+    accepted for the samplers and counts, and a study without references is refused (ValueError naming
+    both ways to give them) before its directory is made."""
+    s = study.StudySettings(scenes=["cornell"], out=tmp_path / "s", samplers=("bose", "sobol"), spp=(16, 64))
+    assert (s.scenes, s.samplers, s.spp) == (("cornell",), "bose,sobol", "16,64")
+    with pytest.raises(ValueError, match="a study needs references: --reference SCENE=REF.exr"):
+        study.run_study(s)
+    assert not (tmp_path / "s").exists()
+    with pytest.raises(ValueError, match="--spp: 'x' is not an integer"):
+        study.run_study(study.StudySettings(scenes=("cornell",), out=tmp_path / "t", spp="16,x",
+                                            reference_spp=64))
