@@ -42,21 +42,37 @@ def faure(xp, i, j, b: int, n: int, p):
     i, j, p = xp.as_uint32(i, j, p)
     col, block = j % b, j // b
     P = block_seed(xp, p, block)
-    q = derived_seed(xp, P, col, FAURE_KEY)
-    K = out_digits(b)
     copies = block != 0
     scramble = xp.may_any(copies)
+    # the copies' scrambled indices have every digit; block 0's extra digits are 0
+    a = index_digits(xp, i, b, out_digits(b) if scramble else n)
     if scramble:
-        n = K  # the copies' scrambled indices have every digit; block 0's extra digits are 0
+        a = _index_scramble(xp, a, b, xp.select(copies, hash_pair(xp, P, b, FAURE_INDEX_KEY), 0))
+    return digits_value(xp, a, b, col, derived_seed(xp, P, col, FAURE_KEY))
+
+
+def index_digits(xp, i, b: int, n: int) -> list:
+    """The ``n`` lowest base-``b`` digits of the uint32 or uint64 indices
+    ``i`` as uint32 arrays, the least significant first."""
     a = []
     rest = i
     for _ in range(n):
-        a.append(rest % b)
+        a.append(xp.u32(rest % b))  # a no-op on uint32 indices
         rest = rest // b
-    if scramble:
-        a = _index_scramble(xp, a, b, xp.select(copies, hash_pair(xp, P, b, FAURE_INDEX_KEY), 0))
-    # Taylor shift: the coefficients of A(x + col) mod b (products < b**2 <= 2**24)
-    for k in range(n - 1):
+    return a
+
+
+def digits_value(xp, a: list, b: int, col, q):
+    """:func:`pyoa.reference.faure.digits_value`: coordinate ``col`` of the
+    index digits ``a`` (uint32 arrays, least significant first, after any
+    index scramble), Owen-scrambled with seed ``q``: the Taylor shift, the
+    output scramble and the float rule."""
+    K = out_digits(b)
+    n = len(a)
+    a = list(a)
+    # Taylor shift: the coefficients of A(x + col) mod b (products < b**2 <= 2**24);
+    # step k fixes y_k, and only y_0 .. y_(K-1) are read
+    for k in range(min(n - 1, K)):
         for r in range(n - 2, k - 1, -1):
             a[r] = (a[r] + col * a[r + 1]) % b
     numer = 0

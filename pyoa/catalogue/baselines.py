@@ -31,7 +31,7 @@ from ..tables import pmj02 as pmj02_tables, sequences
 from .._numpy import baselines as _numpy_baselines
 from .._numpy import pmj02 as _numpy_pmj02
 from .._numpy import zsobol as _numpy_zsobol
-from .entries import MAX_SPP, Claim, CountRule, SppChoice, register
+from .entries import MAX_SPP, Claim, CountRule, SppChoice, check_resolution, register
 from .params import PointSetParams, SequenceParams
 from ..reference import baselines as _reference_baselines
 from ..reference import pmj02 as _reference_pmj02
@@ -336,17 +336,9 @@ class ZSobol(Baseline):
                    "needs resolution=(width, height)")
 
     def with_resolution(self, params, resolution):
-        if resolution is None:
-            raise ValueError("zsobol needs the image: resolution=(width, height), each in [1, 65536] (its Z-order "
-                             "curve spans the image; pixels are numbered row-major, y * width + x)")
-        if isinstance(resolution, (str, bytes)) or not isinstance(resolution, Sequence) or len(resolution) != 2:
-            raise TypeError(f"resolution must be a pair (width, height) of ints, got {resolution!r}")
-        for what, v in zip(("width", "height"), resolution):
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral):
-                raise TypeError(f"resolution {what} must be an int, got {type(v).__name__} {v!r}")
-            if not 1 <= int(v) <= 1 << _reference_zsobol.MAX_LOG2RES:
-                raise ValueError(f"resolution {what} must be in [1, {1 << _reference_zsobol.MAX_LOG2RES}], got {v}")
-        return dataclasses.replace(params, resolution=(int(resolution[0]), int(resolution[1])))
+        resolution = check_resolution(self.name, resolution, 1 << _reference_zsobol.MAX_LOG2RES,
+                                      "its Z-order curve spans the image")
+        return dataclasses.replace(params, resolution=resolution)
 
     def pixel_count(self, params):
         width, height = params.resolution

@@ -165,6 +165,23 @@ class _Counts(Sequence):
         return isinstance(other, Sequence) and len(other) == self._len and all(a == b for a, b in zip(self, other))
 
 
+def check_resolution(name: str, resolution, largest: int, why: str) -> tuple[int, int]:
+    """``resolution`` as ``(width, height)`` ints for sampler ``name``, which
+    needs the image (``why`` says what for); TypeError or ValueError saying
+    what is valid otherwise: each side in ``[1, largest]``."""
+    if resolution is None:
+        raise ValueError(f"{name} needs the image: resolution=(width, height), each in [1, {largest}] ({why}; "
+                         "pixels are numbered row-major, y * width + x)")
+    if isinstance(resolution, (str, bytes)) or not isinstance(resolution, Sequence) or len(resolution) != 2:
+        raise TypeError(f"resolution must be a pair (width, height) of ints, got {resolution!r}")
+    for what, v in zip(("width", "height"), resolution):
+        if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+            raise TypeError(f"resolution {what} must be an int, got {type(v).__name__} {v!r}")
+        if not 1 <= int(v) <= largest:
+            raise ValueError(f"resolution {what} must be in [1, {largest}], got {v}")
+    return int(resolution[0]), int(resolution[1])
+
+
 def nearest(choices: list[SppChoice], spp: int) -> list[SppChoice]:
     """The choices nearest ``spp`` on both sides: those of the largest count
     below it, of ``spp`` itself, and of the smallest count above it (one side

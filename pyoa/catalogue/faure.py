@@ -23,13 +23,20 @@ References
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 import numbers
+from collections.abc import Sequence
+
+import numpy as np
 
 from .._numpy import faure as _numpy_faure
-from .entries import MAX_SPP, Claim, CountRule, SppChoice, register
+from .._numpy import zfaure as _numpy_zfaure
+from .entries import MAX_SPP, Claim, CountRule, Launch, SppChoice, check_resolution, register
 from .params import FaureParams
 from ..reference import faure as _reference_faure
+from ..reference import zfaure as _reference_zfaure
 
 #: Largest base (the largest prime ``b`` with ``b**2 <= 2**24``).
 MAX_BASE = _reference_faure.MAX_BASE
@@ -155,3 +162,169 @@ class Faure(CountRule):
         return [dict(spp=1, dims=1), dict(spp=13, dims=7), dict(spp=49, dims=8, base=7),
                 dict(spp=MAX_SPP, dims=3, base=2), dict(spp=MAX_SPP, dims=3),
                 dict(spp=4, dims=600, base=31), dict(spp=28, dims=3, base=3)]
+
+
+def zfaure_bases(spp: int) -> list[int]:
+    """The primes ``b`` with ``b**2`` dividing ``spp``: the bases ``zfaure`` takes at ``spp``."""
+    return [b for b in BASES if b * b <= spp and spp % (b * b) == 0]
+
+
+def zfaure_default_base(spp: int, dims: int | None = None) -> int | None:
+    """The base ``zfaure`` uses when none is given (the rule of :class:`ZFaure`),
+    None if ``spp`` has no square prime factor.
+
+    The smallest prime ``b >= dims`` with ``b**2`` dividing ``spp`` (every
+    dimension in one block), else the largest such prime (as many dimensions
+    per block as ``spp`` allows).
+
+    >>> zfaure_default_base(25, 4), zfaure_default_base(100, 2), zfaure_default_base(100, 4), zfaure_default_base(30)
+    (5, 2, 5, None)
+    """
+    fits = zfaure_bases(spp)
+    if not fits:
+        return None
+    return next((b for b in fits if b >= (dims or 1)), fits[-1])
+
+
+class _ZCounts(Sequence):
+    """The counts ``zfaure`` takes (those with a square prime factor) up to
+    ``2**24``, as choices made on demand (6.5 million of them)."""
+
+    def __init__(self, make):
+        self._make = make
+
+    @functools.cached_property
+    def _counts(self) -> np.ndarray:
+        ok = np.zeros(MAX_SPP + 1, dtype=bool)
+        for b in BASES:
+            ok[b * b::b * b] = True
+        return np.flatnonzero(ok).astype(np.uint32)
+
+    def __len__(self):
+        return len(self._counts)
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self._make(int(n)) for n in self._counts[k]]
+        return self._make(int(self._counts[k]))
+
+
+@register
+class ZFaure(Faure):
+    """``zfaure``: one Faure sequence handed out along a scrambled Morton order
+    of the image, blue-noise error in every dimension of a block.
+
+    Needs the image: ``resolution=(width, height)``, each at most ``2**16``,
+    pixels row-major (``pixel = y * width + x``). ``spp`` a multiple of
+    ``b**2`` for a prime ``base=b`` in ``[2, 4093]``. Pixel ``(x, y)`` takes
+    the samples ``z(x, y) * spp + i`` of one Owen-scrambled Faure
+    (0, b)-sequence per block of ``b`` dimensions, ``z`` its position on a
+    base-``b`` Morton order of the image whose tiles permute their rows and
+    columns and transpose at random (nested, from the seed). Each pixel's
+    samples are ``spp / b**2`` orthogonal arrays of strength 2 (its error is
+    ``faure``'s), each row of ``b`` pixels of a tile nets of ``b**3`` samples,
+    each ``b x b`` tile (0,4,b)-nets: neighbouring pixels' errors cancel in
+    every dimension of the block, and the error image is blue noise (little
+    low-frequency power), where ``zsobol``'s is blue only in its first pair.
+
+    **Default base** (``base=None``): the smallest prime ``b >= dims`` with
+    ``b**2`` dividing ``spp``, else the largest prime with ``b**2`` dividing
+    ``spp``. E.g. ``spp=100, dims=4`` gives ``b=5``; ``spp=64`` gives ``b=2``.
+    A count with no square prime factor (``30``) is refused with the nearest
+    valid ones. Not progressive: a pixel's samples sit at ``z * spp``, so the
+    count is part of every value. Math: :func:`pyoa.reference.zfaure.zfaure`
+    and docs/spec.md section 5.12.
+
+    >>> pyoa.sampler("zfaure", spp=25, dims=4, resolution=(64, 64)).base   # doctest: +SKIP
+    5
+    """
+
+    name = "zfaure"
+    code = 14
+    drjit_module = "zfaure"
+    progressive = False
+    why_not_progressive = ("a pixel's samples are indices z * spp + i of one sequence, so the count is part of "
+                           "every value: render all of it at once")
+    spp_invariant = False
+    needs_resolution = True
+    reference = staticmethod(_reference_zfaure.zfaure)
+    numpy = staticmethod(_numpy_zfaure.zfaure)
+    kernel = "pyoa_sample_zfaure"
+    description = ("Faure sequence ordered along a scrambled base-b Morton curve of the image: N a multiple of "
+                   "b^2, blue-noise error in every dimension; needs resolution=(width, height)")
+
+    def params(self, spp, dims):
+        b = zfaure_default_base(spp, dims)
+        return FaureParams(N=spp, b=b, m=_levels(b, spp))
+
+    def valid(self, spp):
+        return 1 <= spp <= self.max_spp and zfaure_default_base(spp) is not None
+
+    def invalid(self, spp, dims, strength):
+        return f"{spp} is not a multiple of b^2 for any prime b (4, 9, 25, 49, ...) in [4, 2^24]"
+
+    def choices(self, dims=None, strength=None):
+        self._check(dims, strength)
+        return _ZCounts(lambda n: self._choice(n, dims))
+
+    def nearest(self, spp, dims=None, strength=None):
+        self._check(dims, strength)
+        spp = min(max(int(spp), 0), self.max_spp + 1)
+        below = next((n for n in range(spp - 1, 3, -1) if self.valid(n)), None)
+        above = next((n for n in range(spp + 1, self.max_spp + 1) if self.valid(n)), None)
+        return [self._choice(n, dims) for n in (below, spp, above) if n is not None and self.valid(n)]
+
+    def with_resolution(self, params, resolution):
+        resolution = check_resolution(self.name, resolution, _reference_zfaure.MAX_RESOLUTION,
+                                      "its Morton order spans the image")
+        _reference_zfaure.check_shape(params.N, params.b, *resolution)
+        return dataclasses.replace(params, resolution=resolution)
+
+    def with_base(self, params, base):
+        if base is None:
+            return params
+        params = super().with_base(params, base)
+        if params.N % (params.b * params.b):
+            valid = [n for n in range(params.b**2, self.max_spp + 1, params.b**2)]
+            near = sorted(valid, key=lambda n: (abs(n - params.N), n))[:2]
+            raise ValueError(f"zfaure: spp must be a multiple of b^2 = {params.b**2} in base {params.b}, got "
+                             f"{params.N}; nearest: {', '.join(map(str, sorted(near)))}"
+                             f"{'' if not zfaure_bases(params.N) else '; bases that divide it: ' + ', '.join(map(str, zfaure_bases(params.N)))}")
+        if params.resolution is not None:
+            _reference_zfaure.check_shape(params.N, params.b, *params.resolution)
+        return params
+
+    def pixel_count(self, params):
+        width, height = params.resolution
+        return width * height
+
+    def arguments(self, params):
+        return {"base": params.b, "resolution": params.resolution}
+
+    def grid(self, params) -> int:
+        """``k``: the digits of the padded ``b**k x b**k`` grid of the image."""
+        return _reference_zfaure.grid_digits(params.b, *params.resolution)
+
+    def shape_args(self, params):
+        return (params.N, params.b, self.grid(params), params.resolution[0])
+
+    def seed_args(self, pixel_seed, seed, pixel):
+        return (pixel, seed)  # the order needs the pixel itself; the seed keys the one sequence
+
+    def launch(self, params, offset, jitter):
+        # the kernel's three shape words: N, the base with k in its high half, the width
+        N, b, k, width = self.shape_args(params)
+        return Launch(f"generate_{self.function}", (np.uint32(N), np.uint32(b | k << 16), np.uint32(width),
+                                                    np.float32(jitter)))
+
+    def claims(self, params, offset):
+        return [Claim("faure", n=params.N, s=params.b, strength=min(3, max(params.m, 1)), block_dims=params.b)]
+
+    def test_cases(self):
+        # one pixel at the smallest count; base 5 on a non-square image not a power of 5, over two
+        # blocks; base 2 at full HD (T past 2**32); base 7 past a block; the largest count at a
+        # large image in base 2; the largest base
+        return [dict(spp=4, dims=1, resolution=(1, 1)), dict(spp=50, dims=7, resolution=(7, 3), base=5),
+                dict(spp=16, dims=3, resolution=(1920, 1080), base=2), dict(spp=49, dims=9, resolution=(16, 16)),
+                dict(spp=MAX_SPP, dims=3, resolution=(4096, 4096), base=2),
+                dict(spp=4093**2, dims=2, resolution=(2, 2), base=4093)]

@@ -15,7 +15,7 @@ every entry of its type:
     ``random``, ``sobol02``, ``halton``, ``sobol``, ``zsobol``, ``pmj02``;
 :class:`FaureParams`
     a Faure (0, s)-sequence in a prime base: ``faure`` (docs/spec.md
-    section 5.11).
+    section 5.11) and ``zfaure`` (section 5.12).
 
 What a listing shows of them (the public :class:`pyoa.SppChoice` and the
 sampler attributes ``s``, ``strength`` and ``block_dims``) is the entry's
@@ -119,8 +119,12 @@ class FaureParams:
     m : int
         Full nets: the largest ``m`` with ``b**m <= N`` (the first ``b**m``
         samples are a (0, m, b)-net; 0 below ``b`` samples).
+    resolution : (int, int) or None
+        ``(width, height)`` of the image for ``zfaure``, whose pixels read
+        the sequence along an order of the image; None for ``faure``.
     """
 
     N: int
     b: int
     m: int
+    resolution: tuple[int, int] | None = None

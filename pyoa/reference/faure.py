@@ -184,18 +184,28 @@ def faure(i: int, j: int, b: int, n: int, p: int) -> float:
     col, block = j % b, j // b
     P = block_seed(p, block)
     q = derived_seed(P, col, FAURE_KEY)
-    K = out_digits(b)
     a = []
     rest = i
-    for _ in range(K if block else n):
+    for _ in range(out_digits(b) if block else n):
         a.append(rest % b)
         rest //= b
     if block:
         # every copy past the first reads the sequence in its own nested order
         a = index_scramble(a, b, hash_pair(P, b, FAURE_INDEX_KEY))
-        n = K
+    return digits_value(a, b, col, q)
+
+
+def digits_value(a: list[int], b: int, col: int, q: int) -> float:
+    """Coordinate ``col`` of the index with base-``b`` digits ``a`` (least
+    significant first), Owen-scrambled with seed ``q`` (0: unscrambled): the
+    Taylor shift, the nested digit scramble and the float rule of the module
+    docstring. Only the first ``K`` output digits are made, so the shift
+    stops once ``y_0 .. y_(K-1)`` are final (step ``k`` fixes ``y_k``)."""
+    n = len(a)
+    a = list(a)
+    K = out_digits(b)
     # Taylor shift: a becomes the coefficients of A(x + col) mod b, y_k = a[k]
-    for k in range(n - 1):
+    for k in range(min(n - 1, K)):
         for r in range(n - 2, k - 1, -1):
             a[r] = (a[r] + col * a[r + 1]) % b
     numer, prefix, power = 0, 0, 1  # power = b**k, prefix = (y_0 ... y_{k-1})_b
