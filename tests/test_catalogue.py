@@ -86,7 +86,7 @@ def test_every_entry_is_complete_and_its_cases_resolve():
 #: The parameter type each family resolves to (pyoa.catalogue.params), per entry class.
 PARAMETER_TYPES = {"bose": OAParams, "bush": OAParams, "cmjnd": OAParams, "addelman-kempthorne": OAParams,
                    "bose-bush": OAParams, "jittered2d": PointSetParams, "cmj2d": PointSetParams,
-                   "faure": FaureParams}
+                   "faure": FaureParams, "zfaure": FaureParams}
 
 
 @pytest.mark.parametrize("name, kw", CASES, ids=map(case_id, CASES))

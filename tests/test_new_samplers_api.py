@@ -34,11 +34,17 @@ def zsobol(resolution=RES, *, spp=16, dims=4, seed=0, backend="numpy"):
 
 # --------------------------------------------------------------------------- resolution: required, refused, checked
 
-@pytest.mark.parametrize("name", [n for n in pyoa.samplers() if n != "zsobol"])
+@pytest.mark.parametrize("name", [n for n in pyoa.samplers() if n not in ("zsobol", "zfaure")])
 def test_every_other_sampler_refuses_a_resolution(name):
     spp = pyoa.valid_spp(name, dims=2)[0].spp
-    with pytest.raises(ValueError, match=rf"{name} takes no resolution"):
+    with pytest.raises(ValueError, match=rf"{name} takes no resolution; only zsobol, zfaure depend"):
         pyoa.sampler(name, spp=spp, dims=2, resolution=(4, 3), backend="numpy")
+
+
+@pytest.mark.parametrize("name", ["zsobol", "zfaure"])
+def test_the_image_samplers_need_a_resolution(name):
+    with pytest.raises(ValueError, match=rf"{name} needs the image: resolution=\(width, height\)"):
+        pyoa.sampler(name, spp=16, dims=2, backend="numpy")
 
 
 def test_zsobol_needs_a_resolution():

@@ -1,6 +1,6 @@
 """Screen-space error spectra: how a sampler's per-pixel errors are laid out.
 
-:func:`error_spectrum` integrates a 2D integrand in every pixel of an image,
+:func:`error_spectrum` integrates a ``d``-dimensional integrand in every pixel of an image,
 Fourier transforms the error image and averages its periodogram over seeds,
 normalized so that independent per-pixel errors (white noise) are flat at 1;
 :class:`ErrorSpectrum` holds it, its radial mean (:func:`radial_mean`) and a
@@ -54,6 +54,8 @@ class ErrorSpectrum:
     ----------
     sampler, integrand : str
         What was measured.
+    dims : int
+        The integrand's dimensions (the sampler's dimensions ``0 .. dims-1``).
     spp, size, seeds : int
         Samples per pixel, image side (``size x size`` pixels) and how many
         seeds (independent images) were averaged.
@@ -76,6 +78,7 @@ class ErrorSpectrum:
     sampler: str
     integrand: str
     spp: int
+    dims: int
     size: int
     seeds: int
     power: np.ndarray = field(repr=False)
@@ -87,7 +90,7 @@ class ErrorSpectrum:
     def table(self) -> Markdown:
         """Markdown: what was measured and its summary numbers, a field per row."""
         return field_table(f"Error spectrum of `{self.sampler}` on `{self.integrand}`", [
-            ("spp", self.spp), ("image", f"{self.size} x {self.size}"), ("seeds", self.seeds),
+            ("spp", self.spp), ("dimensions", self.dims), ("image", f"{self.size} x {self.size}"), ("seeds", self.seeds),
             ("low-frequency power (white noise = 1)", f"{self.low:.4g}"), ("RMSE per pixel", f"{self.rmse:.4g}")])
 
     def __repr__(self) -> str:
@@ -98,12 +101,13 @@ class ErrorSpectrum:
 
 
 def error_spectrum(sampler: str, *, spp: int, size: int = 64, seeds: int = 8, integrand: str = "ball",
-                   seed: int = 0, backend: str | None = None) -> ErrorSpectrum:
+                   dims: int = 2, seed: int = 0, base: int | None = None,
+                   backend: str | None = None) -> ErrorSpectrum:
     """How a sampler's per-pixel errors are distributed across the image.
 
-    Each pixel of a ``size x size`` image estimates the integral of the 2D
-    ``integrand`` with its own ``spp`` samples (dimensions 0 and 1, pixels
-    numbered row-major); the error image ``e(x, y) = estimate - exact`` is
+    Each pixel of a ``size x size`` image estimates the integral of the
+    ``dims``-dimensional ``integrand`` with its own ``spp`` samples
+    (dimensions ``0 .. dims-1``, pixels numbered row-major); the error image ``e(x, y) = estimate - exact`` is
     Fourier transformed and its periodogram ``|E(k)|^2 / size^2`` averaged
     over ``seeds`` seeds, then divided by the error variance (the mean over
     all non-zero frequencies), so that independent per-pixel errors give a
@@ -124,10 +128,17 @@ def error_spectrum(sampler: str, *, spp: int, size: int = 64, seeds: int = 8, in
     seeds : int
         Independent images averaged, 1 to 1024.
     integrand : str
-        A 2D integrand of :data:`INTEGRANDS` (default ``"ball"``: a disk,
+        An integrand of :data:`INTEGRANDS` (default ``"ball"``: a disk,
         discontinuous like a shadow edge).
+    dims : int
+        Its dimensions, 1 to 64 (default 2). ``zsobol``'s blue noise lives
+        in its first pair of dimensions; ``zfaure``'s in every dimension of
+        a block.
     seed : int
         First user seed; images use ``seed, seed + 1, ...``.
+    base : int, optional
+        The digit base of a sampler that has one (``faure``, ``zfaure``);
+        its default otherwise.
     backend : str, optional
         As :func:`pyoa.sampler`.
 
@@ -153,13 +164,18 @@ def error_spectrum(sampler: str, *, spp: int, size: int = 64, seeds: int = 8, in
     size = _checked_int("size", size, 8, 1024)
     seeds = _checked_int("seeds", seeds, 1, 1024)
     seed = _checked_int("seed", seed, 0, 2**32 - seeds)
-    f = _lookup(integrand, 2)
-    options = {"backend": backend, "resolution": (size, size)} if pyoa.catalogue.get(sampler).needs_resolution \
-        else {"backend": backend}
+    dims = _checked_int("dims", dims, 1, 64)
+    f = _lookup(integrand, dims)
+    entry = pyoa.catalogue.get(sampler)
+    options = {"backend": backend}
+    if entry.needs_resolution:
+        options["resolution"] = (size, size)
+    if base is not None:
+        options["base"] = base  # the sampler refuses a base it does not have, naming those that do
     acc = np.zeros((size, size))
     sq = 0.0
     for k in range(seeds):
-        smp = pyoa.sampler(sampler, spp=spp, dims=2, seed=seed + k, **options)
+        smp = pyoa.sampler(sampler, spp=spp, dims=dims, seed=seed + k, **options)
         err = f(smp.generate(pixels=range(size * size))).mean(axis=1) - f.exact
         sq += float(np.mean(err**2))
         acc += np.abs(np.fft.fft2(err.reshape(size, size))) ** 2 / (size * size)
@@ -171,6 +187,6 @@ def error_spectrum(sampler: str, *, spp: int, size: int = 64, seeds: int = 8, in
     ky, kx = np.mgrid[-c:size - c, -c:size - c]
     r = np.hypot(kx, ky)
     low = float(power[(r >= 1) & (r <= size / 8)].mean())
-    return ErrorSpectrum(sampler=pyoa.catalogue.get(sampler).name, integrand=f.name, spp=smp.spp, size=size,
+    return ErrorSpectrum(sampler=entry.name, integrand=f.name, spp=smp.spp, dims=dims, size=size,
                          seeds=seeds, power=power, radii=radii, radial=radial, low=low,
                          rmse=math.sqrt(sq / seeds))

@@ -27,13 +27,12 @@ import dataclasses
 import functools
 import math
 import numbers
-from collections.abc import Sequence
 
 import numpy as np
 
 from .._numpy import faure as _numpy_faure
 from .._numpy import zfaure as _numpy_zfaure
-from .entries import MAX_SPP, Claim, CountRule, Launch, SppChoice, check_resolution, register
+from .entries import MAX_SPP, Claim, CountRule, Launch, SppChoice, check_resolution, nearest, register
 from .params import FaureParams
 from ..reference import faure as _reference_faure
 from ..reference import zfaure as _reference_zfaure
@@ -164,49 +163,17 @@ class Faure(CountRule):
                 dict(spp=4, dims=600, base=31), dict(spp=28, dims=3, base=3)]
 
 
-def zfaure_bases(spp: int) -> list[int]:
-    """The primes ``b`` with ``b**2`` dividing ``spp``: the bases ``zfaure`` takes at ``spp``."""
-    return [b for b in BASES if b * b <= spp and spp % (b * b) == 0]
-
-
-def zfaure_default_base(spp: int, dims: int | None = None) -> int | None:
-    """The base ``zfaure`` uses when none is given (the rule of :class:`ZFaure`),
-    None if ``spp`` has no square prime factor.
-
-    The smallest prime ``b >= dims`` with ``b**2`` dividing ``spp`` (every
-    dimension in one block), else the largest such prime (as many dimensions
-    per block as ``spp`` allows).
-
-    >>> zfaure_default_base(25, 4), zfaure_default_base(100, 2), zfaure_default_base(100, 4), zfaure_default_base(30)
-    (5, 2, 5, None)
-    """
-    fits = zfaure_bases(spp)
-    if not fits:
-        return None
-    return next((b for b in fits if b >= (dims or 1)), fits[-1])
-
-
-class _ZCounts(Sequence):
-    """The counts ``zfaure`` takes (those with a square prime factor) up to
-    ``2**24``, as choices made on demand (6.5 million of them)."""
-
-    def __init__(self, make):
-        self._make = make
-
-    @functools.cached_property
-    def _counts(self) -> np.ndarray:
-        ok = np.zeros(MAX_SPP + 1, dtype=bool)
-        for b in BASES:
-            ok[b * b::b * b] = True
-        return np.flatnonzero(ok).astype(np.uint32)
-
-    def __len__(self):
-        return len(self._counts)
-
-    def __getitem__(self, k):
-        if isinstance(k, slice):
-            return [self._make(int(n)) for n in self._counts[k]]
-        return self._make(int(self._counts[k]))
+@functools.cache
+def zfaure_counts() -> dict[int, tuple[int, int]]:
+    """Every count ``zfaure`` takes, ``N = b**m`` (``b`` a prime, ``m >= 2``,
+    ``N <= 2**24``), mapped to its ``(b, m)``, in increasing order of ``N``."""
+    counts = {}
+    for b in BASES:
+        power, m = b * b, 2
+        while power <= MAX_SPP:
+            counts[power] = (b, m)
+            power, m = power * b, m + 1
+    return dict(sorted(counts.items()))
 
 
 @register
@@ -215,27 +182,28 @@ class ZFaure(Faure):
     of the image, blue-noise error in every dimension of a block.
 
     Needs the image: ``resolution=(width, height)``, each at most ``2**16``,
-    pixels row-major (``pixel = y * width + x``). ``spp`` a multiple of
-    ``b**2`` for a prime ``base=b`` in ``[2, 4093]``. Pixel ``(x, y)`` takes
+    pixels row-major (``pixel = y * width + x``). Pixel ``(x, y)`` takes
     the samples ``z(x, y) * spp + i`` of one Owen-scrambled Faure
     (0, b)-sequence per block of ``b`` dimensions, ``z`` its position on a
     base-``b`` Morton order of the image whose tiles permute their rows and
     columns and transpose at random (nested, from the seed). Each pixel's
-    samples are ``spp / b**2`` orthogonal arrays of strength 2 (its error is
-    ``faure``'s), each row of ``b`` pixels of a tile nets of ``b**3`` samples,
-    each ``b x b`` tile (0,4,b)-nets: neighbouring pixels' errors cancel in
+    ``b**m`` samples are a (0,m,b)-net (an orthogonal array of strength 2 and
+    more), each row of ``b`` pixels of a tile a (0,m+1,b)-net, each ``b x b``
+    tile a (0,m+2,b)-net: neighbouring pixels' errors cancel in
     every dimension of the block, and the error image is blue noise (little
     low-frequency power), where ``zsobol``'s is blue only in its first pair.
 
-    **Default base** (``base=None``): the smallest prime ``b >= dims`` with
-    ``b**2`` dividing ``spp``, else the largest prime with ``b**2`` dividing
-    ``spp``. E.g. ``spp=100, dims=4`` gives ``b=5``; ``spp=64`` gives ``b=2``.
-    A count with no square prime factor (``30``) is refused with the nearest
-    valid ones. Not progressive: a pixel's samples sit at ``z * spp``, so the
-    count is part of every value. Math: :func:`pyoa.reference.zfaure.zfaure`
-    and docs/spec.md section 5.12.
+    **Counts**: ``spp = b**m``, a power of a prime ``b`` with ``m >= 2``
+    (4, 8, 9, 16, 25, 27, 32, 49, 64, 81, 121, 125, 128, ...): each pixel's
+    samples are then one aligned block of the sequence, a (0,m,b)-net, so its
+    error is ``faure``'s at the same count and base, and each tile's samples
+    an aligned block too. The count fixes the base (``base=``, if given, must
+    be it): every dimension of a 4D integrand shares one block from ``b = 5``
+    (25, 125, 625 samples). Not progressive: a pixel's samples sit at
+    ``z * spp``, so the count is part of every value. Math:
+    :func:`pyoa.reference.zfaure.zfaure` and docs/spec.md section 5.12.
 
-    >>> pyoa.sampler("zfaure", spp=25, dims=4, resolution=(64, 64)).base   # doctest: +SKIP
+    >>> pyoa.sampler("zfaure", spp=125, dims=4, resolution=(64, 64)).base   # doctest: +SKIP
     5
     """
 
@@ -250,29 +218,25 @@ class ZFaure(Faure):
     reference = staticmethod(_reference_zfaure.zfaure)
     numpy = staticmethod(_numpy_zfaure.zfaure)
     kernel = "pyoa_sample_zfaure"
-    description = ("Faure sequence ordered along a scrambled base-b Morton curve of the image: N a multiple of "
-                   "b^2, blue-noise error in every dimension; needs resolution=(width, height)")
+    description = ("Faure sequence ordered along a scrambled base-b Morton curve of the image: N = b^m (a prime "
+                   "power, m >= 2), blue-noise error in every dimension; needs resolution=(width, height)")
 
     def params(self, spp, dims):
-        b = zfaure_default_base(spp, dims)
-        return FaureParams(N=spp, b=b, m=_levels(b, spp))
+        b, m = zfaure_counts()[spp]
+        return FaureParams(N=spp, b=b, m=m)
 
     def valid(self, spp):
-        return 1 <= spp <= self.max_spp and zfaure_default_base(spp) is not None
+        return spp in zfaure_counts()
 
     def invalid(self, spp, dims, strength):
-        return f"{spp} is not a multiple of b^2 for any prime b (4, 9, 25, 49, ...) in [4, 2^24]"
+        return f"{spp} is not a power b^m of a prime b with m >= 2 (4, 8, 9, 16, 25, 27, 32, ...) up to 2^24"
 
     def choices(self, dims=None, strength=None):
         self._check(dims, strength)
-        return _ZCounts(lambda n: self._choice(n, dims))
+        return [self._choice(n, dims) for n in zfaure_counts()]
 
     def nearest(self, spp, dims=None, strength=None):
-        self._check(dims, strength)
-        spp = min(max(int(spp), 0), self.max_spp + 1)
-        below = next((n for n in range(spp - 1, 3, -1) if self.valid(n)), None)
-        above = next((n for n in range(spp + 1, self.max_spp + 1) if self.valid(n)), None)
-        return [self._choice(n, dims) for n in (below, spp, above) if n is not None and self.valid(n)]
+        return nearest(self.choices(dims, strength), spp)
 
     def with_resolution(self, params, resolution):
         resolution = check_resolution(self.name, resolution, _reference_zfaure.MAX_RESOLUTION,
@@ -281,18 +245,12 @@ class ZFaure(Faure):
         return dataclasses.replace(params, resolution=resolution)
 
     def with_base(self, params, base):
-        if base is None:
+        if base is None or super().with_base(params, base).b == params.b:
             return params
-        params = super().with_base(params, base)
-        if params.N % (params.b * params.b):
-            valid = [n for n in range(params.b**2, self.max_spp + 1, params.b**2)]
-            near = sorted(valid, key=lambda n: (abs(n - params.N), n))[:2]
-            raise ValueError(f"zfaure: spp must be a multiple of b^2 = {params.b**2} in base {params.b}, got "
-                             f"{params.N}; nearest: {', '.join(map(str, sorted(near)))}"
-                             f"{'' if not zfaure_bases(params.N) else '; bases that divide it: ' + ', '.join(map(str, zfaure_bases(params.N)))}")
-        if params.resolution is not None:
-            _reference_zfaure.check_shape(params.N, params.b, *params.resolution)
-        return params
+        powers = [n for n, (b, _) in zfaure_counts().items() if b == base]
+        raise ValueError(f"zfaure: {params.N} samples are {params.b}^{params.m}, base {params.b}; base {base} takes "
+                         f"{', '.join(map(str, powers[:6]))}{', ...' if len(powers) > 6 else ''} (the count fixes "
+                         "the base: give one of these counts, or no base)")
 
     def pixel_count(self, params):
         width, height = params.resolution
@@ -322,9 +280,8 @@ class ZFaure(Faure):
 
     def test_cases(self):
         # one pixel at the smallest count; base 5 on a non-square image not a power of 5, over two
-        # blocks; base 2 at full HD (T past 2**32); base 7 past a block; the largest count at a
-        # large image in base 2; the largest base
-        return [dict(spp=4, dims=1, resolution=(1, 1)), dict(spp=50, dims=7, resolution=(7, 3), base=5),
-                dict(spp=16, dims=3, resolution=(1920, 1080), base=2), dict(spp=49, dims=9, resolution=(16, 16)),
-                dict(spp=MAX_SPP, dims=3, resolution=(4096, 4096), base=2),
-                dict(spp=4093**2, dims=2, resolution=(2, 2), base=4093)]
+        # blocks; base 2 at full HD at 4096 spp (T past 2**32); base 7 past a block; the largest
+        # count at a large image in base 2; the largest base
+        return [dict(spp=4, dims=1, resolution=(1, 1)), dict(spp=125, dims=7, resolution=(7, 3), base=5),
+                dict(spp=4096, dims=3, resolution=(1920, 1080)), dict(spp=49, dims=9, resolution=(16, 16)),
+                dict(spp=MAX_SPP, dims=3, resolution=(4096, 4096)), dict(spp=4093**2, dims=2, resolution=(2, 2))]
