@@ -91,17 +91,19 @@ class PyoaEngine(qmc.QMCEngine):
         (``"bose"``, the default; ``"bush"``, ``"cmjnd"``,
         ``"addelman-kempthorne"``, ``"bose-bush"``) or a comparison sampler
         (``"random"``, ``"jittered2d"``, ``"cmj2d"``, ``"sobol02"``,
-        ``"halton"``, ``"sobol"``, ``"zsobol"``, ``"pmj02"``) or the
-        progressive ``"faure"`` (any `spp`; see `base`). ``zsobol``
-        needs an image: the engine's arrays are pixels ``0, 1, ...`` of
-        :data:`pyoa.samplers.TRIAL_RESOLUTION` (65536 x 65536, row-major).
+        ``"halton"``, ``"sobol"``, ``"zsobol"``, ``"pmj02"``), the
+        progressive ``"faure"`` (any `spp`; see `base`) or ``"zfaure"``
+        (`spp` a prime power ``b**m``, ``m >= 2``). ``zsobol`` and
+        ``zfaure`` need an image: the engine's arrays are pixels ``0, 1, ...``
+        of :data:`pyoa.samplers.TRIAL_RESOLUTION` (65536 x 65536, row-major).
     strength : int, optional
         ``bush`` and ``cmjnd`` only: the strength t, with ``spp = s**t``.
         Default: pyoa's (the largest ``t <= d`` for which `spp` is a t-th power).
     base : int, optional
-        ``faure`` only: its prime digit base ``b`` in ``[2, 4093]`` (every
-        aligned block of ``b**m`` points of an array is a (0, m, b)-net).
-        Default: pyoa's, from `spp` and `d` (see :func:`pyoa.sampler`).
+        ``faure`` and ``zfaure`` only: the prime digit base ``b`` in
+        ``[2, 4093]`` (every aligned block of ``b**m`` points of an array is
+        a (0, m, b)-net). Default: pyoa's, from `spp` and `d` (see
+        :func:`pyoa.sampler`); ``zfaure``'s count fixes it.
     offset : {"cmj", "mj", "j", "centered"}, optional
         Orthogonal arrays only: where a point sits inside its coarse stratum
         (default ``"cmj"``, correlated multi-jittered). See :func:`pyoa.sampler`.

@@ -30,6 +30,7 @@ SAMPLERS = {
     "random": {"spp": 10, "dims": 5},
     "faure": {"spp": 25, "dims": 6},
     "zsobol": {"spp": 16, "dims": 5, "resolution": (8, 6)},
+    "zfaure": {"spp": 25, "dims": 7, "resolution": (8, 6)},
     "cmjnd": {"spp": 27, "dims": 7, "strength": 3},
 }
 
