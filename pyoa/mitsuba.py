@@ -3,7 +3,7 @@
 Importing this module (or calling :func:`register`) registers the sampler
 type ``pyoa`` with Mitsuba for the current variant and for every variant set
 later, so a Mitsuba scene renders with any orthogonal array of pyoa, with
-``faure`` or with ``random``::
+``faure``, ``zfaure`` or with ``random``::
 
     import mitsuba as mi
     import pyoa.mitsuba
@@ -25,7 +25,8 @@ Parameters
 ----------
 sampler : str
     The pyoa sampler (default ``"bose"``): ``bose``, ``bush``, ``cmjnd``,
-    ``addelman-kempthorne``, ``bose-bush``, ``faure`` or ``random``
+    ``addelman-kempthorne``, ``bose-bush``, ``faure``, ``zfaure`` (on the
+    film's pixels, below) or ``random``
     (:data:`pyoa._drjit.SUPPORTED`; the other comparison samplers read
     tables and are left to Mitsuba's own samplers), in any case, or a
     Mitsuba/pbrt name of one of them (``orthogonal``, ``independent``:
@@ -42,9 +43,10 @@ seed : int
 offset, jitter, strength, base, dims : str, float, int, int, int
     pyoa's options (:func:`pyoa.sampler`): the OA offset style (``cmj``,
     ``j``, ``mj``, ``centered``), the jitter amount in [0, 1], the strength
-    t of ``bush``/``cmjnd``, ``faure``'s prime base, and the number of
-    dimensions the integrator uses (only ``cmjnd`` and ``faure`` choose a
-    default strength or base from it; 0, the default, leaves it open).
+    t of ``bush``/``cmjnd``, ``faure``'s prime base (``zfaure``'s is fixed by
+    its count ``b**m``), and the number of dimensions the integrator uses
+    (only ``cmjnd`` and ``faure`` choose a default strength or base from it;
+    0, the default, leaves it open).
 samples_per_pass : int
     Only for an integrator that renders in passes (its own
     ``samples_per_pass``): the same value, a divisor of ``sample_count``.
@@ -72,6 +74,22 @@ film's pixels row by row, border included where the film samples one.
 unseeded); neither changes the values: they depend only on (seed, pixel,
 sample, dimension).
 
+``zfaure`` hands one sequence out to the pixels along an order of the image,
+so its pixel is the film's: pixel ``p`` of the window Mitsuba renders (the
+film's crop, row by row) is the film's pixel ``(x, y) = (crop_x + p %
+crop_width, crop_y + p // crop_width)``, and the values are exactly
+``pyoa.sampler("zfaure", spp=N, seed=S, resolution=(width, height),
+...).generate(pixels=[y * width + x])``: a crop renders the full image's
+samples on its pixels. Mitsuba never tells a sampler its film, so at each
+render's ``seed()`` the plugin finds the sensor being rendered among the
+Python frames that called it (``mi.render`` and the Python integrators hold
+it; a direct ``integrator.render(scene, sensor)`` is called with it) and
+reads its film (:func:`_rendered_film`); a sampler seeded by hand is given
+its film with ``set_film(film)``. Refused with a ValueError saying why: no
+film found, a film whose window is not the wavefront's pixels, a film that
+samples a border (``sample_border``: those lanes lie outside the image), and
+an adjoint integrator (``ptracer``: its lanes are light paths, no pixels).
+
 Values are computed with Dr.Jit operations (:mod:`pyoa._drjit`), traced into
 Mitsuba's own kernels: no host round trip, so the sampler runs at Mitsuba's
 speed. JIT variants (``llvm_*``, ``cuda_*``) only: loading the sampler in a
@@ -81,6 +99,8 @@ speed. JIT variants (``llvm_*``, ``cuda_*``) only: loading the sampler in a
 from __future__ import annotations
 
 import ctypes
+import sys
+from typing import NamedTuple
 
 from .util.drjit_llvm import configure as _configure_llvm
 
@@ -93,6 +113,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without mitsuba
     raise ImportError("pyoa.mitsuba needs Mitsuba 3: pip install 'pyoa[mitsuba]'") from exc
 
 from . import _drjit
+from . import catalogue as _catalogue
 from .catalogue.entries import MAX_DIMS, MAX_UINT32
 from .samplers import sampler as _pyoa_sampler
 
@@ -120,16 +141,84 @@ def _props(props) -> dict:
     return out
 
 
-def _resolve(opts: dict, spp: int):
-    """The pyoa Sampler of these options at ``spp`` (pyoa's own checks and messages)."""
+def _resolve(opts: dict, spp: int, resolution=None):
+    """The pyoa Sampler of these options at ``spp`` (pyoa's own checks and messages).
+
+    A sampler of an image (``zfaure``) takes ``resolution``, the film's size; before a film is
+    known, ``(1, 1)`` checks every other parameter (the count and the base) with pyoa's messages."""
     name = opts.get("sampler", "bose")
     _drjit.implementation(name)  # ValueError naming the supported samplers
     dims = opts.get("dims", 0)
     if not 0 <= dims <= MAX_DIMS:
         raise ValueError(f"pyoa sampler: dims must be in [0, {MAX_DIMS}] (0: unknown), got {dims}")
+    image = {"resolution": resolution or (1, 1)} if _catalogue.get(name).needs_resolution else {}
     return _pyoa_sampler(name, spp=spp, dims=dims or MAX_DIMS, seed=0, offset=opts.get("offset"),
                          jitter=opts.get("jitter", 1.0), strength=opts.get("strength"), base=opts.get("base"),
-                         backend="numpy")  # never used to generate: no OpenCL set-up
+                         backend="numpy", **image)  # never used to generate: no OpenCL set-up
+
+
+class _FilmGrid(NamedTuple):
+    """Where Mitsuba's lanes lie on a film: the film's ``size`` (width, height) and the window it
+    renders, ``crop_offset`` and ``crop_size`` (each (x, y)). Mitsuba's render loops give lane ``l``
+    the pixel ``l // n`` of the window, row by row (``SamplingIntegrator::render``), which is pixel
+    ``(x, y) = (crop_offset.x + p % crop_width, crop_offset.y + p // crop_width)`` of the film."""
+
+    size: tuple[int, int]
+    crop_offset: tuple[int, int]
+    crop_size: tuple[int, int]
+
+    @classmethod
+    def of(cls, film) -> _FilmGrid:
+        """The grid of a Mitsuba film; ValueError for a film whose lanes are not all its pixels."""
+        if film.sample_border() and film.rfilter().border_size() > 0:
+            raise ValueError(
+                f"pyoa sampler: the film samples a border of {film.rfilter().border_size()} pixels around its "
+                "image (hdrfilm sample_border=true): those lanes are no pixels of the image, so an image sampler "
+                "(zfaure) has no place for them on its order; render with sample_border=false")
+        return cls(*(tuple(int(v) for v in vec) for vec in (film.size(), film.crop_offset(), film.crop_size())))
+
+    def pixels(self, lane_pixel):
+        """The film's row-major pixel index (``y * width + x``) of window pixel ``lane_pixel``."""
+        if self.crop_size == self.size:
+            return lane_pixel
+        y = lane_pixel // self.crop_size[0]
+        x = lane_pixel - y * self.crop_size[0]
+        return (y + self.crop_offset[1]) * self.size[0] + x + self.crop_offset[0]
+
+
+def _rendered_film(smp) -> _FilmGrid | None:
+    """The film that the render now seeding ``smp`` renders, or None when none is found.
+
+    Mitsuba never tells a sampler its film (a sensor holds both; nothing links the sampler back),
+    but every render loop is called with the sensor: ``mi.render``'s custom operation and the
+    Python integrators' ``prepare`` hold it as a local variable, and a direct
+    ``integrator.render(scene, sensor)`` is called from a frame holding the scene or the sensor.
+    So the Python frames that led to this ``seed()`` are searched, innermost first, for a sensor
+    whose sampler is ``smp`` or the sampler ``smp`` was cloned from (the Python integrators seed a
+    clone); the innermost frame with one decides. A frame whose matching sensors have different
+    films is refused: the lanes cannot be told apart.
+    """
+    mine = (smp, smp._origin)
+    frame = sys._getframe(3)  # past this function, _film_for_seed() and seed()
+    while frame is not None:
+        values = list(frame.f_locals.values())
+        sensors = [v for v in values if isinstance(v, mi.Sensor) and v.sampler() in mine]
+        if not sensors:
+            sensors = [s for v in values if isinstance(v, mi.Scene) for s in v.sensors() if s.sampler() in mine]
+        if sensors:
+            adjoint = [v for v in values if isinstance(v, mi.AdjointIntegrator)]
+            if adjoint:
+                raise ValueError(
+                    f"pyoa sampler: {smp._pyoa.name} orders the film's pixels, but the integrator is an adjoint "
+                    "one (mi.AdjointIntegrator: ptracer), which traces paths from the emitters: its lanes are no "
+                    "pixels; use a sampler of single pixels (faure, bose, ...) with it")
+            grids = {_FilmGrid.of(s.film()) for s in sensors}
+            if len(grids) > 1:
+                raise ValueError(f"pyoa sampler: the sampler is shared by sensors with different films "
+                                 f"({sorted(grids)}); give each sensor its own sampler")
+            return grids.pop()
+        frame = frame.f_back
+    return None
 
 
 #: How many 32-bit words at the start of a sampler's C++ object :func:`_find_samples_per_wavefront`
@@ -182,6 +271,9 @@ def _make_class(base: type) -> type:
             opts = props if isinstance(props, dict) else _props(mi.Properties() if props is None else props)
             super().__init__(mi.Properties())
             self._opts = dict(opts)
+            self._origin = None  # the sampler this one was cloned from (_rendered_film)
+            self._film = None  # the _FilmGrid given by set_film(), for a sampler seeded outside a render
+            self._pyoa = None
             self._base_seed = self._opts.get("seed", 0)
             if not 0 <= self._base_seed <= MAX_UINT32:
                 raise ValueError(f"pyoa sampler: seed must be a uint32 in [0, {MAX_UINT32}], got {self._base_seed}")
@@ -198,7 +290,8 @@ def _make_class(base: type) -> type:
         def _configure(self, spp: int) -> None:
             """Make ``spp`` the sample count: every check runs before any state changes, so a refused
             count (``mi.render(scene, spp=N)``) leaves the sampler exactly as it was."""
-            pyoa_sampler = _resolve(self._opts, spp)
+            # an image sampler keeps the film of its last seed(): a count refused for it is refused here
+            pyoa_sampler = _resolve(self._opts, spp, self._pyoa.resolution if self._pyoa else None)
             per_pass = self._opts.get("samples_per_pass", 0) or spp
             if per_pass < 1 or spp % per_pass:
                 raise ValueError(f"pyoa sampler: samples_per_pass ({per_pass}) must divide sample_count ({spp}); "
@@ -232,8 +325,17 @@ def _make_class(base: type) -> type:
 
         @property
         def pyoa_sampler(self):
-            """The :class:`pyoa.samplers.Sampler` whose values this plugin draws (seed 0; Mitsuba sets the seed)."""
+            """The :class:`pyoa.samplers.Sampler` whose values this plugin draws (seed 0; Mitsuba sets the seed).
+
+            For an image sampler (``zfaure``) its resolution is the film's since the last ``seed()``
+            ((1, 1) before one)."""
             return self._pyoa
+
+        def set_film(self, film) -> None:
+            """The film whose pixels this sampler's lanes are, for an image sampler (``zfaure``) seeded
+            outside a render (a render finds its film itself, :func:`_rendered_film`): a ``mi.Film``
+            (``mi.load_dict({"type": "hdrfilm", "width": W, "height": H})``). Checked like a render's."""
+            self._film = _FilmGrid.of(film)
 
         # -- state --------------------------------------------------------------------------------------
 
@@ -241,7 +343,7 @@ def _make_class(base: type) -> type:
             self.m_dimension = mi.UInt32(0)
             self.m_pass = mi.UInt32(0)
             self._passes = 0  # m_pass on the host, to refuse samples past sample_count
-            self._pixel_seed = None
+            self._seed_args = None
             self._lane_sample = None
             self._forget_block()
 
@@ -260,21 +362,52 @@ def _make_class(base: type) -> type:
                 if n == 0:
                     raise ValueError("pyoa sampler: the first seed() needs the wavefront size (lanes)")
             per_pass = self._mitsuba_samples_per_wavefront()
-            if n >= per_pass:  # (smaller: the 1-lane seed Mitsuba gives after a render to release memory)
+            whole = n >= per_pass  # (fewer: the 1-lane seed Mitsuba gives after a render to release memory)
+            if whole:
                 self._check_wavefront(n, per_pass)
+            entry = self._pyoa._construction
+            grid = self._film_for_seed(n // per_pass) if whole and entry.needs_resolution else None
+            pyoa_sampler = self._pyoa
+            if grid and grid.size != pyoa_sampler.resolution:
+                pyoa_sampler = _resolve(self._opts, self._spp, grid.size)
             super().seed(seed, wavefront_size)
+            self._pyoa = pyoa_sampler
             lane = dr.arange(mi.UInt32, n)
             s = mi.UInt32(seed) + self._base_seed if dr.is_array_v(seed) else mi.UInt32((int(seed) + self._base_seed) % 2**32)
             # opaque, as Mitsuba's own samplers make theirs: a literal seed would be baked into the traced
             # kernel, and every new seed would compile a new one (measured: 0.35 s per render for bose)
             dr.make_opaque(s)
-            self._pixel_seed = _drjit.hashes.pixel_seed(s, lane // self._spw)
+            pixel = lane // self._spw
+            # the catalogue's seed arguments, once per seed: the pixel's point-set seed, or (an image
+            # sampler, which has drawable lanes only with a film) the film's pixel and the seed
+            if not entry.needs_resolution:
+                self._seed_args = entry.seed_args(_drjit.hashes.pixel_seed, s, pixel)
+            else:
+                self._seed_args = entry.seed_args(_drjit.hashes.pixel_seed, s, grid.pixels(pixel)) if grid else None
             self._lane_sample = lane % self._spw
             # opaque, as Mitsuba's own counters: one kernel serves every pass
             self.m_dimension = dr.opaque(mi.UInt32, 0)
             self.m_pass = dr.opaque(mi.UInt32, 0)
             self._passes = 0
             self._forget_block()
+
+        def _film_for_seed(self, pixels: int) -> _FilmGrid:
+            """The film an image sampler's ``pixels`` lanes of whole pixels lie on: the film of the render
+            seeding it, else the one given to :meth:`set_film`; ValueError when there is none, or when its
+            window (the crop) is not ``pixels`` pixels."""
+            grid = _rendered_film(self) or self._film
+            name = self._pyoa.name
+            if grid is None:
+                raise ValueError(
+                    f"pyoa sampler: {name} orders the film's pixels, and no film was found for this seed(): render "
+                    "with mi.render(scene) or integrator.render(scene, sensor), or call sampler.set_film(film) "
+                    "before seeding the sampler yourself")
+            (w, h), (cw, ch) = grid.size, grid.crop_size
+            if cw * ch != pixels:
+                raise ValueError(f"pyoa sampler: {name} was seeded with {pixels} pixels of lanes, but the film "
+                                 f"renders {cw} x {ch} pixels{f' (a crop of {w} x {h})' if (cw, ch) != (w, h) else ''}"
+                                 ": the lanes are not the film's pixels")
+            return grid
 
         def _check_wavefront(self, n: int, per_pass: int) -> None:
             """Refuse a wavefront of ``n`` lanes that Mitsuba splits into pixels of ``per_pass`` samples
@@ -303,7 +436,8 @@ def _make_class(base: type) -> type:
         def clone(self):
             other = type(self)(dict(self._opts, sample_count=self._spp))
             other.set_samples_per_wavefront(self._spw)
-            other._pixel_seed, other._lane_sample = self._pixel_seed, self._lane_sample
+            other._origin, other._film, other._pyoa = self._origin or self, self._film, self._pyoa
+            other._seed_args, other._lane_sample = self._seed_args, self._lane_sample
             other.m_dimension, other.m_pass = mi.UInt32(self.m_dimension), mi.UInt32(self.m_pass)
             other._passes = self._passes
             other._block, other._block_seed, other._block_row = (mi.UInt32(x) for x in (
@@ -318,8 +452,9 @@ def _make_class(base: type) -> type:
         # -- values -------------------------------------------------------------------------------------
 
         def next_1d(self, active=True):
-            if self._pixel_seed is None:
-                raise RuntimeError("pyoa sampler: seed() the sampler before drawing values")
+            if self._seed_args is None:
+                on_film = " (with whole pixels of lanes on a film)" if self._pyoa._construction.needs_resolution else ""
+                raise RuntimeError(f"pyoa sampler: seed() the sampler before drawing values{on_film}")
             if self._passes * self._spw >= self._spp:
                 raise RuntimeError(f"pyoa sampler: pass {self._passes} of {self._spw} samples is past sample_count "
                                    f"{self._spp} (advance() was called {self._passes} times since seed())")
@@ -328,7 +463,7 @@ def _make_class(base: type) -> type:
             i = self.m_pass * self._spw + self._lane_sample
             j = mi.UInt32(self.m_dimension)
             f = _drjit.implementation(entry.name)
-            args = (i, j, *entry.shape_args(smp.params), self._pixel_seed, *entry.options(smp.offset, smp.jitter))
+            args = (i, j, *entry.shape_args(smp.params), *self._seed_args, *entry.options(smp.offset, smp.jitter))
             x = f(*args, located=self._located(i, j)) if entry.drjit_located else f(*args)
             self.m_dimension += 1
             return mi.Float(x)
@@ -342,7 +477,7 @@ def _make_class(base: type) -> type:
             Dr.Jit skips its body on every draw that stays in the block."""
             prm = self._pyoa.params
             N, block = prm.N, j // prm.B
-            p = self._pixel_seed
+            (p,) = self._seed_args
 
             def locate(P, row, todo):
                 P, row = _drjit.hashes.locate_block(p, i, block, N)

@@ -28,6 +28,16 @@ SEEDS = (0, 1, 2**32 - 1)
 PIXELS = np.array([0, 1, 7, 2**32 - 1], dtype=np.uint32)
 
 
+def pixels_of(smp) -> np.ndarray:
+    """:data:`PIXELS`, or for a sampler of an image (``zfaure``) its corners, the ends of its first
+    two rows, a pixel in the middle and the last pixel: all of its grid's top digits."""
+    if smp.resolution is None:
+        return PIXELS
+    w, h = smp.resolution
+    picks = [0, 1, w - 1, w, 2 * w - 1, (h // 2) * w + w // 2, (h - 1) * w, h * w - 1]
+    return np.unique(np.array([p for p in picks if p < w * h], dtype=np.uint32))
+
+
 def offsets(name):
     return list(OFFSETS) if catalogue.get(name).family == "oa" else [None]
 
@@ -61,7 +71,7 @@ CASES = [(name, case, off) for name in _drjit.SUPPORTED for case in catalogue.ge
 
 
 def test_supported_names_are_the_catalogue_entries_with_an_implementation():
-    assert set(_drjit.SUPPORTED) >= set(catalogue.names("oa")) | {"faure", "random"}
+    assert set(_drjit.SUPPORTED) >= set(catalogue.names("oa")) | {"faure", "zfaure", "random"}
     with pytest.raises(ValueError, match="no Dr.Jit implementation.*supported: bose"):
         _drjit.implementation("sobol")
     with pytest.raises(ValueError, match="unknown sampler|valid"):
@@ -75,9 +85,21 @@ def test_drjit_equals_numpy_on_the_catalogue_cases(name, case, offset, seed):
     if offset is not None:
         kw["offset"] = offset
     smp = pyoa.sampler(name, seed=seed, backend="numpy", **kw)
-    samples, dims = edges(smp.spp), edges(smp.dims, 20)
-    assert_same_bits(drjit_values(smp, PIXELS, samples, dims), numpy_values(smp, PIXELS, samples, dims),
+    samples, dims, pixels = edges(smp.spp), edges(smp.dims, 20), pixels_of(smp)
+    assert_same_bits(drjit_values(smp, pixels, samples, dims), numpy_values(smp, pixels, samples, dims),
                      f"{name} {kw} seed {seed}")
+
+
+def test_zfaure_spec_vectors():
+    """docs/spec.md section 5.12's vectors (read by tests/test_zfaure.py), from Dr.Jit: past the first
+    block and past a 32-bit index."""
+    from .test_zfaure import VECTORS
+
+    assert VECTORS
+    for b, N, W, H, px, seed, _z, i, j, want in VECTORS:
+        smp = pyoa.sampler("zfaure", spp=N, dims=j + 1, resolution=(W, H), seed=seed, backend="numpy")
+        got = _drjit.evaluate("zfaure", UInt32([i]), UInt32([j]), smp.params, seed, UInt32([px]))
+        assert np.asarray(got).view(np.uint32)[0] == want, (b, N, W, H, px, seed, i, j)
 
 
 def test_jitter_amounts_and_every_value_of_a_small_array():
@@ -140,6 +162,10 @@ def random_sampler(draw):
         base = draw(st.sampled_from([2, 3, 5, 7, 11, 13, 31, 127, 4093]))
         spp = draw(st.integers(1, 4096))
         kw = dict(base=base)
+    elif name == "zfaure":
+        base = draw(st.sampled_from([2, 3, 5, 7, 11, 13, 31, 127]))
+        spp = base ** draw(st.integers(2, max(2, int(np.log(4096) / np.log(base)))))  # b^m, m >= 2
+        kw = dict(base=base, resolution=(draw(st.integers(1, 2000)), draw(st.integers(1, 2000))))
     else:
         choices = entry.choices(dims=dims)
         spp = draw(st.sampled_from([c.spp for c in choices[: min(len(choices), 60)]]))
@@ -154,7 +180,7 @@ def random_sampler(draw):
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(smp=random_sampler(), pixel=st.integers(0, 2**32 - 1))
 def test_drjit_equals_numpy_on_random_parameters(smp, pixel):
-    pixels = np.array([pixel, pixel ^ 1], dtype=np.uint32)
+    pixels = (np.array([pixel, pixel ^ 1], dtype=np.uint64) % smp.n_pixels).astype(np.uint32)  # in the image
     samples, dims = edges(smp.spp, 12), edges(smp.dims, 12)
     assert_same_bits(drjit_values(smp, pixels, samples, dims), numpy_values(smp, pixels, samples, dims),
                      repr(smp))

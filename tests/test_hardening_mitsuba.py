@@ -91,7 +91,7 @@ def test_passes_unlike_the_sampler_s_are_refused(bose_16, sampler_pass, integrat
 
 
 #: (sampler, sample_count, samples_per_pass of the sampler and the integrator)
-CONFIGURED = {"bose": ("bose", 16, 4), "faure": ("faure", 25, 5)}
+CONFIGURED = {"bose": ("bose", 16, 4), "faure": ("faure", 25, 5), "zfaure": ("zfaure", 25, 5)}
 
 
 @pytest.fixture(scope="module")
@@ -110,6 +110,8 @@ REFUSED = [
     ("bose", 32, r"bose: 32 is not s\^2 .*nearest: 25 \(s=5\), 49 \(s=7\)"),
     ("faure", 4, r"samples_per_pass \(5\) must divide sample_count \(4\)"),
     ("faure", 32, r"samples_per_pass \(5\) must divide sample_count \(32\)"),
+    ("zfaure", 10, r"zfaure: 10 is not a power b\^m of a prime b with m >= 2"),
+    ("zfaure", 49, r"samples_per_pass \(5\) must divide sample_count \(49\)"),
 ]
 
 
@@ -127,8 +129,10 @@ def test_a_refused_spp_leaves_the_sampler_as_it_was(fresh, key, refused, match):
     # checked before rendering: a half-configured sampler drew sample indices its construction does not
     # have (bose: the render never ended) or another base (faure: base 2 after a refused spp=4)
     assert (smp.sample_count(), smp.pyoa_sampler.spp, repr(smp)) == (spp, spp, description)
-    if name == "faure":
-        assert smp.pyoa_sampler.params.b == 5  # faure's base (the largest prime b with b^2 <= 25)
+    if name in ("faure", "zfaure"):
+        assert smp.pyoa_sampler.params.b == 5  # the base of 25 (faure: the largest prime b with b^2 <= 25)
+    if name == "zfaure":  # still the image of the film its renders found
+        assert smp.pyoa_sampler.resolution == (SIZE, SIZE)
     assert (bits(mi.render(sc, seed=5)) == image).all()
 
 

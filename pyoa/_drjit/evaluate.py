@@ -11,14 +11,14 @@ from __future__ import annotations
 import drjit as dr
 
 from .. import catalogue
-from . import baselines, faure, hashes, oa
+from . import baselines, faure, hashes, oa, zfaure
 
 #: The modules of the Dr.Jit implementations, by the name an entry gives
 #: (``entry.drjit_module``): an entry is supported when its module defines a
 #: function named as the entry (``entry.function``). Every orthogonal array,
-#: faure and random; the other comparison samplers read tables (Sobol'
-#: matrices, PMJ02 points) and are left to Mitsuba's own samplers.
-MODULES = {"oa": oa, "faure": faure, "baselines": baselines}
+#: faure, zfaure and random; the other comparison samplers read tables
+#: (Sobol' matrices, PMJ02 points) and are left to Mitsuba's own samplers.
+MODULES = {"oa": oa, "faure": faure, "zfaure": zfaure, "baselines": baselines}
 
 #: Entry name -> its Dr.Jit implementation, from the catalogue.
 IMPLEMENTATIONS = {
