@@ -2,7 +2,7 @@
 section 5.12; pyoa/reference/zfaure.py, pyoa/_arrays/zfaure.py,
 kernels/include/pyoa/zfaure.h), exactly.
 
-- The order: seed 0 is plain Morton; every seed's order is a bijection of
+- The order: every seed scrambles (0 included); every seed's order is a bijection of
   the padded grid, whose runs of ``b**(2u)`` positions are ``b**u x b**u``
   tiles and whose runs of ``b`` are a row or a column of a ``b x b`` tile.
 - The value: block 0 is ``faure`` read at ``T = z N + i`` (while
@@ -58,10 +58,16 @@ def morton(x: int, y: int, b: int, k: int) -> int:
 # ----------------------------------------------------------------------------- the order of the pixels
 
 @pytest.mark.parametrize("b, k", [(2, 3), (3, 2), (5, 2), (7, 1)])
-def test_seed_zero_is_plain_morton(b, k):
+def test_every_seed_scrambles_seed_zero_too(b, k):
+    """User seed 0 (a render's default) is no plain Morton order and no unscrambled sequence: both
+    repeat one arrangement in every tile, a periodic pattern in the error image."""
     n = b**k
-    assert [rz.pixel_code(x, y, b, k, 0) for y in range(n) for x in range(n)] == \
-        [morton(x, y, b, k) for y in range(n) for x in range(n)]
+    for seed in (0, 1):
+        S = rz.sequence_seed(seed, b)
+        assert S != 0
+        assert [rz.pixel_code(x, y, b, k, S) for y in range(n) for x in range(n)] != \
+            [morton(x, y, b, k) for y in range(n) for x in range(n)]
+    assert rz.zfaure(0, 0, b * b, b, k, n, 0, 0) != rf.faure(morton(0, 0, b, k) * b * b, 0, b, rf.out_digits(b), 0)
 
 
 @pytest.mark.parametrize("b, k", [(2, 4), (3, 3), (5, 2), (7, 2)])
@@ -71,10 +77,11 @@ def test_the_order_is_a_bijection_of_tiles_and_rows(b, k, seed):
     is one aligned b^u x b^u tile; each run of b is one row or one column of
     a b x b tile; NumPy's codes are the reference's."""
     n = b**k
+    S = rz.sequence_seed(seed, b)
     y, x = np.divmod(np.arange(n * n), n)
-    z = np.array([rz.pixel_code(int(a), int(c), b, k, seed) for a, c in zip(x, y)])
+    z = np.array([rz.pixel_code(int(a), int(c), b, k, S) for a, c in zip(x, y)])
     assert np.array_equal(np.sort(z), np.arange(n * n))
-    got = nz_code(x, y, b, k, seed)
+    got = nz_code(x, y, b, k, S)
     assert np.array_equal(got, z)
     where = np.empty((n * n, 2), np.int64)
     where[z] = np.stack([x, y], axis=1)
@@ -85,14 +92,14 @@ def test_the_order_is_a_bijection_of_tiles_and_rows(b, k, seed):
     same_y = (runs[:, :, 1] == runs[:, :1, 1]).all(axis=1)
     same_x = (runs[:, :, 0] == runs[:, :1, 0]).all(axis=1)
     assert (same_x | same_y).all(), "a run of b positions is neither a row nor a column"
-    if seed and k >= 2:
+    if k >= 2:
         assert same_x.any() and same_y.any(), "the tiles are never transposed (or always)"
 
 
-def nz_code(x, y, b, k, seed):
+def nz_code(x, y, b, k, S):
     from pyoa._arrays import bind, zfaure as generic
     from pyoa._numpy import ops
-    return bind(ops, generic.pixel_code)(np.asarray(x, U32), np.asarray(y, U32), b, k, np.asarray(seed, U32))
+    return bind(ops, generic.pixel_code)(np.asarray(x, U32), np.asarray(y, U32), b, k, np.asarray(S, U32))
 
 
 # ----------------------------------------------------------------------------- the values, exactly
@@ -100,14 +107,15 @@ def nz_code(x, y, b, k, seed):
 @pytest.mark.parametrize("b, W, H, N", [(5, 25, 25, 25), (2, 16, 16, 16), (3, 9, 7, 27), (7, 5, 5, 49)])
 @pytest.mark.parametrize("seed", [0, 3, U32_MAX])
 def test_block_zero_is_faure_read_along_the_order(b, W, H, N, seed):
-    """Block 0 of zfaure is faure (seed p) at index z N + i, while D = K and T < 2^24."""
+    """Block 0 of zfaure is faure (seed S, the sequence's) at index z N + i, while D = K and T < 2^24."""
     k = rz.grid_digits(b, W, H)
+    S = rz.sequence_seed(seed, b)
     assert rz.total_digits(b, k, N) == rf.out_digits(b)
     for px in (0, 1, W * H // 2, W * H - 1):
-        z = rz.pixel_code(px % W, px // W, b, k, seed)
+        z = rz.pixel_code(px % W, px // W, b, k, S)
         for i in (0, 1, N - 1):
             for j in range(b):
-                assert rz.zfaure(i, j, N, b, k, W, px, seed) == rf.faure(z * N + i, j, b, rf.out_digits(b), seed)
+                assert rz.zfaure(i, j, N, b, k, W, px, seed) == rf.faure(z * N + i, j, b, rf.out_digits(b), S)
 
 
 @st.composite
@@ -184,7 +192,7 @@ def test_the_page_has_zfaure_vectors():
 def test_spec_vectors(vector, backend):
     b, N, W, H, px, seed, z, i, j, want = vector
     k = rz.grid_digits(b, W, H)
-    assert rz.pixel_code(px % W, px // W, b, k, seed) == z
+    assert rz.pixel_code(px % W, px // W, b, k, rz.sequence_seed(seed, b)) == z
     assert int(F32(rz.zfaure(i, j, N, b, k, W, px, seed)).view(U32)) == want
     smp = zf(N, j + 1, (W, H), seed=seed, backend=backend)
     assert smp.base == b
@@ -209,7 +217,7 @@ def _row_points(x, W, H, b, seed, k):
     codes = {}
     for y in range(H):
         for c in range(W):
-            codes[rz.pixel_code(c, y, b, k, seed)] = y * W + c
+            codes[rz.pixel_code(c, y, b, k, rz.sequence_seed(seed, b))] = y * W + c
     runs = []
     for start in range(0, b ** (2 * k), b):
         pix = [codes.get(start + r) for r in range(b)]

@@ -14,20 +14,24 @@ from ..reference.faure import FAURE_KEY
 from ..reference.zfaure import ZFAURE_AXIS_KEY, ZFAURE_INDEX_KEY, ZFAURE_ORDER_KEY, ZFAURE_TILE_KEY, total_digits
 from .blocks import block_seed
 from .faure import digits_value, index_digits
-from .hashes import derived_seed, hash_pair, permute
+from .hashes import derived_seed, hash_pair, mix32, permute
 
 
-def pixel_code(xp, x, y, b: int, k: int, seed):
-    """:func:`pyoa.reference.zfaure.pixel_code` (uint64); ``seed == 0`` lanes take plain Morton."""
-    code = xp.u64(xp.zeros(x, y, seed))
-    plain = seed == 0
-    t = hash_pair(xp, seed, b, ZFAURE_ORDER_KEY)
+def axis_permute(xp, d, b: int, h):
+    """:func:`pyoa.reference.zfaure.axis_permute`."""
+    return permute(xp, permute(xp, d, b, h), b, mix32(xp, h))
+
+
+def pixel_code(xp, x, y, b: int, k: int, S):
+    """:func:`pyoa.reference.zfaure.pixel_code` (uint64) for the sequence seed ``S``."""
+    code = xp.u64(xp.zeros(x, y, S))
+    t = S
     for level in range(k):  # the most significant digits first
         scale = b ** (k - 1 - level)
         dx, dy = x // scale % b, y // scale % b
-        gx = permute(xp, dx, b, xp.select(plain, 0, hash_pair(xp, t, 0, ZFAURE_AXIS_KEY)))
-        gy = permute(xp, dy, b, xp.select(plain, 0, hash_pair(xp, t, 1, ZFAURE_AXIS_KEY)))
-        swap = xp.select(plain, 0, hash_pair(xp, t, 2, ZFAURE_AXIS_KEY) >> 31) != 0
+        gx = axis_permute(xp, dx, b, hash_pair(xp, t, 0, ZFAURE_AXIS_KEY))
+        gy = axis_permute(xp, dy, b, hash_pair(xp, t, 1, ZFAURE_AXIS_KEY))
+        swap = (hash_pair(xp, t, 2, ZFAURE_AXIS_KEY) >> 31) != 0
         if level + 1 < k:  # the last level's hash is never used
             t = hash_pair(xp, t, dy * b + dx, ZFAURE_TILE_KEY)
         code = code * (b * b) + xp.u64(xp.select(swap, gx * b + gy, gy * b + gx))
@@ -47,10 +51,11 @@ def chained_scramble(xp, a: list, b: int, h, copies) -> list:
 def zfaure(xp, i, j, N: int, b: int, k: int, width: int, pixel, seed):
     """:func:`pyoa.reference.zfaure.zfaure` over arrays."""
     i, j, pixel, seed = xp.as_uint32(i, j, pixel, seed)
-    T = pixel_code(xp, pixel % width, pixel // width, b, k, seed) * N + xp.u64(i)
+    S = hash_pair(xp, seed, b, ZFAURE_ORDER_KEY)  # never 0: every seed scrambles
+    T = pixel_code(xp, pixel % width, pixel // width, b, k, S) * N + xp.u64(i)
     a = index_digits(xp, T, b, total_digits(b, k, N))
     col, block = j % b, j // b
-    P = block_seed(xp, seed, block)
+    P = block_seed(xp, S, block)
     copies = block != 0
     if xp.may_any(copies):
         a = chained_scramble(xp, a, b, hash_pair(xp, P, b, ZFAURE_INDEX_KEY), copies)

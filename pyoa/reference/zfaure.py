@@ -15,36 +15,41 @@ dimensions of a block at once. ``zfaure`` hands it out the same way.
 **The order of the pixels.** A ``W x H`` image (pixels row-major, ``pixel =
 y W + x``, ``1 <= W, H <= 2**16``) sits in the ``b**k x b**k`` grid with
 ``k`` the fewest digits with ``b**k >= max(W, H)`` (:func:`grid_digits`).
-With ``x_l, y_l`` the base-``b`` digits of ``x, y`` (``l = 0`` the most
-significant of ``k``), the position of the pixel on the order is::
+The user seed gives the sequence's seed ``S = hash_pair(seed, b,
+ZFAURE_ORDER_KEY)`` (:func:`sequence_seed`; never 0, so every seed, 0
+included, is scrambled). With ``x_l, y_l`` the base-``b`` digits of ``x, y``
+(``l = 0`` the most significant of ``k``), the position of the pixel on the
+order is::
 
     z = sum over l of child_l b**(2 (k-1-l))                     (a base-b**2 number)
     child_l = gy b + gx,  or  gx b + gy when swap_l              (gx, gy: the permuted digits)
-    gx = permute(x_l, b, hash_pair(t_l, 0, ZFAURE_AXIS_KEY))
-    gy = permute(y_l, b, hash_pair(t_l, 1, ZFAURE_AXIS_KEY))
+    gx = axis_permute(x_l, b, hash_pair(t_l, 0, ZFAURE_AXIS_KEY))
+    gy = axis_permute(y_l, b, hash_pair(t_l, 1, ZFAURE_AXIS_KEY))
     swap_l = hash_pair(t_l, 2, ZFAURE_AXIS_KEY) >> 31
-    t_0 = hash_pair(seed, b, ZFAURE_ORDER_KEY),  t_(l+1) = hash_pair(t_l, y_l b + x_l, ZFAURE_TILE_KEY)
+    t_0 = S,  t_(l+1) = hash_pair(t_l, y_l b + x_l, ZFAURE_TILE_KEY)
 
-(:func:`pixel_code`). ``t_l`` is a hash of the seed and of every digit above
-level ``l``: each ``b x b`` tile of every level permutes its columns and its
-rows by its own random permutations and is transposed or not at random, a
-nested (Owen-style) scramble of the axes' digits. Seed 0 gives plain Morton
-(``gx = x_l``, ``gy = y_l``, no swap), as it gives the unscrambled sequence.
-Every ``b**(2u)`` consecutive positions are one ``b**u x b**u`` tile of the
-grid, and every ``b`` consecutive positions one row (or column) of a ``b x
-b`` tile.
+(:func:`pixel_code`), where ``axis_permute(d, b, h) = permute(permute(d, b,
+h), b, mix32(h))``: two of Kensler's permutations composed, as the block
+rule composes them (docs/spec.md section 6), because one alone reaches few
+of the ``b!`` orders of a small ``b`` (896 of the 5040 for ``b = 7``). ``t_l``
+is a hash of the seed and of every digit above level ``l``: each ``b x b``
+tile of every level permutes its columns and its rows by its own random
+permutations and is transposed or not at random, a nested (Owen-style)
+scramble of the axes' digits. Every ``b**(2u)`` consecutive positions are
+one ``b**u x b**u`` tile of the grid, and every ``b`` consecutive positions
+one row (or column) of a ``b x b`` tile.
 
 **The samples.** Pixel ``(x, y)``'s sample ``i`` (``0 <= i < N``, ``N =
-b**m``) is index ``T = z N + i`` of the Faure sequence with seed ``seed``
+b**m``) is index ``T = z N + i`` of the Faure sequence with seed ``S``
 (``T < b**(2k) N <= 2**64``), read as its ``D = max(K, 2k + m)`` lowest
 base-``b`` digits (:func:`total_digits`; ``K`` the output digits of
 :func:`pyoa.reference.faure.out_digits`). Dimension ``j`` is coordinate
-``j mod b`` of the block ``j // b``, with ``P = block_seed(seed, j // b)``:
+``j mod b`` of the block ``j // b``, with ``P = block_seed(S, j // b)``:
 block 0 takes the digits as they are, a copy scrambles all ``D`` of them by
 :func:`chained_scramble` (its own order of pixels and samples, as
 ``faure``'s copies), and :func:`pyoa.reference.faure.digits_value` makes the
 value with the output seed ``derived_seed(P, j mod b, FAURE_KEY)``. In block
-0, while ``T < 2**24``, the value is ``faure(T, j, b, K, seed)``.
+0, while ``T < 2**24``, the value is ``faure(T, j, b, K, S)``.
 
 **What it gives.** ``N = b**m`` with ``m >= 2``. Then a pixel's samples
 are one aligned block of ``b**m`` indices, a (0,m,b)-net in every block of
@@ -82,7 +87,7 @@ from __future__ import annotations
 
 from .baselines import derived_seed
 from .faure import FAURE_KEY, bases, digits_value, index_digits, out_digits
-from .hashes import MASK, block_seed, hash_pair, permute
+from .hashes import MASK, block_seed, hash_pair, mix32, permute
 
 #: Keys of the order's hashes (pyoa's choice: words of SHA-256's initial hash value).
 ZFAURE_ORDER_KEY = 0x6A09E667
@@ -138,21 +143,30 @@ def check_shape(N: int, b: int, width: int, height: int) -> int:
     return k
 
 
-def pixel_code(x: int, y: int, b: int, k: int, seed: int) -> int:
+def sequence_seed(seed: int, b: int) -> int:
+    """``S = hash_pair(seed, b, ZFAURE_ORDER_KEY)``: the seed of the sequence and
+    of the order, never 0 (every user seed, 0 included, scrambles)."""
+    return hash_pair(seed, b, ZFAURE_ORDER_KEY)
+
+
+def axis_permute(d: int, b: int, h: int) -> int:
+    """``permute(permute(d, b, h), b, mix32(h))``: element ``d`` of a random
+    permutation of ``0..b-1`` drawn by ``h``."""
+    return permute(permute(d, b, h), b, mix32(h))
+
+
+def pixel_code(x: int, y: int, b: int, k: int, S: int) -> int:
     """``z``: the position of pixel ``(x, y)`` on the scrambled Morton order
-    of the ``b**k x b**k`` grid (module docstring)."""
+    of the ``b**k x b**k`` grid for the sequence seed ``S`` (module docstring)."""
     code = 0
-    t = hash_pair(seed, b, ZFAURE_ORDER_KEY)
+    t = S
     for level in range(k):  # the most significant digits first
         scale = b ** (k - 1 - level)
         dx, dy = x // scale % b, y // scale % b
-        if seed:
-            gx = permute(dx, b, hash_pair(t, 0, ZFAURE_AXIS_KEY))
-            gy = permute(dy, b, hash_pair(t, 1, ZFAURE_AXIS_KEY))
-            swap = hash_pair(t, 2, ZFAURE_AXIS_KEY) >> 31
-            t = hash_pair(t, dy * b + dx, ZFAURE_TILE_KEY)
-        else:
-            gx, gy, swap = dx, dy, 0
+        gx = axis_permute(dx, b, hash_pair(t, 0, ZFAURE_AXIS_KEY))
+        gy = axis_permute(dy, b, hash_pair(t, 1, ZFAURE_AXIS_KEY))
+        swap = hash_pair(t, 2, ZFAURE_AXIS_KEY) >> 31
+        t = hash_pair(t, dy * b + dx, ZFAURE_TILE_KEY)
         code = code * b * b + (gx * b + gy if swap else gy * b + gx)
     return code
 
@@ -196,9 +210,10 @@ def zfaure(i: int, j: int, N: int, b: int, k: int, width: int, pixel: int, seed:
         raise ValueError(f"pixel must be in [0, width b^k), got {pixel}")
     if not 0 <= seed <= MASK:
         raise ValueError(f"seed must be a uint32 in [0, 2**32), got {seed}")
-    T = pixel_code(pixel % width, pixel // width, b, k, seed) * N + i
+    S = sequence_seed(seed, b)
+    T = pixel_code(pixel % width, pixel // width, b, k, S) * N + i
     col, block = j % b, j // b
-    P = block_seed(seed, block)
+    P = block_seed(S, block)
     a = []
     for _ in range(total_digits(b, k, N)):
         a.append(T % b)
