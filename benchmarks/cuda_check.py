@@ -11,13 +11,13 @@ copy and writes a rectangle of values (pixels x samples x dims) from a
 kernel. This script runs it for every catalogue sampler
 (:data:`pyoa.catalogue.SAMPLERS`) at one of its catalogue entry's
 ``test_cases()`` (the one with the most values per pixel among those of at
-most 4096 samples; zsobol's with its resolution), over the top pixel indices
-(``2**32 - n`` .. ``2**32 - 1``, where a 32-bit overflow would show; zsobol:
-the last pixels of its image), and compares every value, bit for bit, with
-pyoa's NumPy backend (``pyoa.sampler(name, backend="numpy",
-...).generate(pixels=...)``, equal to the reference by the conformance
-suites). ``--all-cases`` runs every test case of at most 65536 samples, the
-orthogonal arrays at every offset.
+most 4096 samples; zsobol's and zfaure's with their resolution), over the top
+pixel indices (``2**32 - n`` .. ``2**32 - 1``, where a 32-bit overflow would
+show; zsobol, zfaure: the last pixels of the image), and compares every
+value, bit for bit, with pyoa's NumPy backend (``pyoa.sampler(name,
+backend="numpy", ...).generate(pixels=...)``, equal to the reference by the
+conformance suites). ``--all-cases`` runs every test case of at most 65536
+samples, the orthogonal arrays at every offset.
 
 The rate: bose at 121 samples x 10 dimensions over pixels 0..65535 (79.3
 million values, 317 MB), the generate benchmark's case, timed with cudaEvents
@@ -192,8 +192,8 @@ def label(case: dict, offset: str | None = None) -> str:
 
 
 def place(case: dict, values: int = CASE_VALUES) -> tuple[int, int]:
-    """(first pixel, pixel count) of a correctness case: the top of the uint32 pixel range (zsobol: of its
-    image), about `values` values (one pixel at least, CASE_PIXELS at most)."""
+    """(first pixel, pixel count) of a correctness case: the top of the uint32 pixel range (zsobol,
+    zfaure: of the image), about `values` values (one pixel at least, CASE_PIXELS at most)."""
     n = max(1, min(CASE_PIXELS, values // (case["spp"] * case["dims"])))
     top = case["resolution"][0] * case["resolution"][1] if "resolution" in case else 2**32
     n = min(n, top)

@@ -23,7 +23,7 @@ are dropped there, since every header it names comes before it.
 #: dependency order (the host-only ones, tables and the renderer API, are
 #: not part of them).
 HEADERS = ("config.h", "keys.h", "hashes.h", "floats.h", "gf.h", "oa.h", "baselines.h", "zsobol.h", "pmj02.h",
-           "faure.h", "values.h")
+           "faure.h", "zfaure.h", "values.h")
 #: The kernel sources of the bulk program.
 SOURCES = ("generate.cl",)
 #: The vector path's program (pyoa._opencl.vector): built per request shape,

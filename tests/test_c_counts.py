@@ -34,7 +34,8 @@ from pyoa import catalogue
 from pyoa.samplers import _offset
 from pyoa.catalogue.entries import MAX_DIMS, MAX_SPP, REGISTRY, _labels, check_int
 from pyoa.catalogue.params import OAParams, PointSetParams
-from pyoa.catalogue.faure import BASES
+from pyoa.catalogue.faure import BASES, zfaure_counts
+from pyoa.reference.zfaure import grid_digits
 
 from .test_c_headers import INCLUDE, WARN, compile_, need
 
@@ -107,9 +108,15 @@ def flat_params(construction, prm, dims) -> tuple:
 
 
 def params_row(construction, spp, dims, prm) -> tuple:
-    """The C shim's row for Python's parameters: pyoa_params' fields, then the shape arguments."""
+    """The C shim's row for Python's parameters: pyoa_params' fields, then the
+    shape arguments as the kernel's three words a, b, c (zero-padded; those of
+    the entry's launch where it has more than three, zfaure's (N, b | k << 16,
+    width))."""
     width, height = construction.arguments(prm).get("resolution") or (0, 0)
-    shape = (*construction.shape_args(prm), 0, 0, 0)[:3]
+    shape = construction.shape_args(prm)
+    if len(shape) > 3:
+        shape = tuple(int(w) for w in construction.launch(prm, None, 1.0).args[:3])
+    shape = (*shape, 0, 0, 0)[:3]
     return (construction.code, spp, *flat_params(construction, prm, dims), width, height, *shape)
 
 
@@ -317,6 +324,27 @@ def test_faure_bases(lib):
     assert sum(g[0] == OK for g in got[: len(bases)]) == len(BASES)
 
 
+def test_zfaure_counts_bases_and_the_64_bit_index(lib):
+    """zfaure's counts, the prime powers b^m (m >= 2, the count fixes b): every one with its neighbours
+    (near 2^24 the nearest valid counts lie thousands away); a base given: the count's own, another
+    prime's (the message lists its counts, "..." past six), non-primes; and the images around the
+    64-bit limit b^(2k) N <= 2^64 of reference.zfaure.check_shape, where it binds: sides b^(k-1) and
+    b^(k-1) + 1 of base 1621 at m = 2 (k = 2: 0.98 * 2^64 fits) and 1627 (past it), 137 and 139 at
+    m = 3 (k = 3), 4093 at m = 2."""
+    counts = list(zfaure_counts())
+    cases = [("zfaure", n + d, None, None, None, HD) for n in counts for d in (-1, 0, 1)]
+    cases += [("zfaure", n, None, None, base, HD) for n in (4, 8, 125, 4093**2, MAX_SPP)
+              for base in (1, 2, 3, 4, 5, 4093, 4099, U32)]
+    for b, m in ((1621, 2), (1627, 2), (137, 3), (139, 3), (4093, 2)):
+        k = grid_digits(b, 65536, 1)
+        for side in (b ** (k - 1), b ** (k - 1) + 1):
+            for res in ((side, 1), (1, side), (side, side)):
+                cases += [("zfaure", b**m, None, None, base, res) for base in (None, b)]
+    got = check(lib, cases)
+    kinds = {g[0] for g in got}
+    assert {OK, SPP, RESOLUTION, BASE} <= kinds, kinds
+
+
 def test_resolutions(lib):
     sizes = [None, (1, 1), (5, 3), HD, (65536, 65536), (65537, 1), (1, 65537), (0, 5), (7, 0), (U32, U32)]
     cases = [(name, spp, None, None, None, r) for name in NAMES for spp in (16, 17) for r in sizes]
@@ -443,7 +471,9 @@ def test_messages_are_truncated_like_snprintf(lib):
     the size (guard bytes), and a NULL buffer is fine."""
     long_cases = [("sobol", 100, None, None, None, None), ("jittered2d", 2, None, None, None, None),
                   ("bose", 0, None, None, None, None), ("zsobol", 16, None, None, None, None),
-                  ("bush", 63, None, None, None, None), ("faure", 9, None, None, 4094, None)]
+                  ("bush", 63, None, None, None, None), ("faure", 9, None, None, 4094, None),
+                  ("zfaure", 30, None, None, None, HD), ("zfaure", 125, None, None, 2, HD),
+                  ("zfaure", 4093**2, None, None, None, (4094, 1))]
     for name, spp, strength, dims, base, resolution in long_cases:
         rc, msg = expect(name, spp, strength, dims, base, resolution)
         assert rc != OK

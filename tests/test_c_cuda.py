@@ -4,9 +4,10 @@ without a GPU can take it.
 - ``values.cu`` compiles with nvcc, with the command cuda_check.py builds it with (pyoa's flags and
   nothing else) plus ``--Werror all-warnings`` and the host compiler's ``-Wall -Wextra``.
 - The program's host path (``--host``: the same rectangle from ``pyoa_sampler_value`` on the CPU, no
-  CUDA call) gives NumPy's values, bit for bit, for samplers with and without tables, zsobol with its
-  image, a sub-rectangle of samples and dimensions and an offset: its arguments, its layout (pixels x
-  samples x dims, row-major) and its file are right, so on a GPU a mismatch can only be the device's.
+  CUDA call) gives NumPy's values, bit for bit, for samplers with and without tables, zsobol and zfaure
+  with their image, a sub-rectangle of samples and dimensions and an offset: its arguments, its layout
+  (pixels x samples x dims, row-major) and its file are right, so on a GPU a mismatch can only be the
+  device's.
   Its errors: a count pyoa refuses (exit 1, the Python API's message), a rectangle outside the
   sampler's ranges (exit 1).
 - Without a GPU, the program exits 2 with cudaGetDeviceCount's reason, and cuda_check.py exits 2 with a
@@ -89,6 +90,7 @@ HOST_CASES = [
      dict(samples=range(3, 12), dims=range(1, 5))),
     ("zsobol", dict(spp=32, dims=5, resolution=(5, 3)), ["--resolution", "5", "3"], {}),
     ("faure", dict(spp=49, dims=8, base=7), ["--base", "7"], {}),
+    ("zfaure", dict(spp=125, dims=7, resolution=(7, 3), base=5), ["--resolution", "7", "3", "--base", "5"], {}),
     ("addelman-kempthorne", dict(spp=18, dims=9), [], {}),
 ]
 
@@ -96,8 +98,8 @@ HOST_CASES = [
 @pytest.mark.parametrize("name, options, extra, rect", HOST_CASES, ids=[c[0] for c in HOST_CASES])
 def test_the_host_path_writes_numpys_values(values, tmp_path, name, options, extra, rect):
     """The rectangle in generate's layout, bit for bit; the pixels at the top of the uint32 range
-    (zsobol: its whole image)."""
-    p0, n = (0, 15) if name == "zsobol" else (2**32 - 3, 3)
+    (zsobol, zfaure: the whole image)."""
+    p0, n = (0, options["resolution"][0] * options["resolution"][1]) if "resolution" in options else (2**32 - 3, 3)
     out = tmp_path / "v.bin"
     res = run(values, name, options["spp"], options["dims"], SEED, p0, n, out, "--host", *extra)
     assert res.returncode == 0, res.stderr
@@ -193,7 +195,7 @@ def test_one_case_per_catalogue_sampler():
     for c in cases:
         case = c["case"]
         assert case in catalogue.get(c["name"]).test_cases() and case["spp"] <= cuda_check.PICK_SPP
-        top = case["resolution"][0] * case["resolution"][1] if c["name"] == "zsobol" else 2**32
+        top = case["resolution"][0] * case["resolution"][1] if "resolution" in case else 2**32
         assert c["pixel0"] + c["pixels"] == top and c["pixels"] >= 1
         assert c["pixels"] * case["spp"] * case["dims"] <= cuda_check.CASE_VALUES or c["pixels"] == 1
 

@@ -41,7 +41,7 @@ from hypothesis import strategies as st
 from pytest_codeblocks import extract_from_file
 
 import pyoa
-from pyoa import c_headers
+from pyoa import c_headers, catalogue
 from pyoa.reference.hashes import frame_seed, hash_pair
 
 from .test_c_headers import WARN, need
@@ -177,7 +177,7 @@ def test_the_margin_fails_for_samplers_that_do_not_stratify_every_pair(built, na
 
 def _python_rms(name: str, spp: int, seed: int, width: int = 32, height: int = 32) -> float:
     """The programs' experiment from the Python API: RMS over pixels of the per-pixel estimate."""
-    resolution = (width, height) if name == "zsobol" else None
+    resolution = (width, height) if catalogue.get(name).needs_resolution else None
     s = pyoa.sampler(name, spp=spp, dims=7, seed=seed, resolution=resolution, backend="numpy")
     x = s.generate(pixels=range(width * height)).astype(np.float64)
     estimate = np.exp(-((x - 0.5) ** 2).sum(axis=-1)).mean(axis=1)
@@ -186,9 +186,9 @@ def _python_rms(name: str, spp: int, seed: int, width: int = 32, height: int = 3
 
 
 @pytest.mark.parametrize("args", [("sobol", "64", "5"), ("zsobol", "64", "1"), ("cmjnd", "121", "3"),
-                                  ("addelman-kempthorne", "50", "0"), ("halton", "49", "2")])
+                                  ("addelman-kempthorne", "50", "0"), ("halton", "49", "2"), ("zfaure", "49", "1")])
 def test_other_samplers_agree_between_c_cpp_and_python(built, args):
-    """Samplers with tables (sobol, halton, addelman-kempthorne) and zsobol, which needs the image:
+    """Samplers with tables (sobol, halton, addelman-kempthorne) and zsobol and zfaure, which need the image:
     the C and C++ programs print the same lines, and the errors are the Python API's."""
     c, cpp = run_example(built, "integrate7d-c", *args), run_example(built, "integrate7d-cpp", *args)
     assert c.returncode == 0 and cpp.returncode == 0, c.stderr + cpp.stderr
@@ -341,7 +341,7 @@ def class_values(lib, name, spp, points, *, dims=0, seed=0, frame=0, convenience
 
 def python_values(name, spp, dims, seed, points):
     s = pyoa.sampler(name, spp=spp, dims=dims, seed=seed, backend="numpy",
-                     resolution=(WIDTH, HEIGHT) if name == "zsobol" else None)
+                     resolution=(WIDTH, HEIGHT) if catalogue.get(name).needs_resolution else None)
     rows = []
     for x, y, i, d0 in points:
         d0 = max(d0, 0)
@@ -353,10 +353,10 @@ def bits(a) -> list:
     return np.asarray(a, np.float32).view(np.uint32).tolist()
 
 
-#: (name, spp): samplers without a table (random, bose over a prime, zsobol with its image) and with one
-#: (sobol's direction numbers, bose over GF(8), cmjnd).
+#: (name, spp): samplers without a table (random, bose over a prime, zsobol and zfaure with their image)
+#: and with one (sobol's direction numbers, bose over GF(8), cmjnd).
 CLASS_CASES = [("bose", 49), ("bose", 64), ("cmjnd", 27), ("sobol", 32), ("zsobol", 16), ("random", 10),
-               ("faure", 25)]
+               ("faure", 25), ("zfaure", 25)]
 DIMS = 24
 
 
@@ -380,10 +380,11 @@ def test_the_class_gives_the_python_apis_bits(cls, name, spp, data):
         assert (pixel, sample, start, end) == (y * WIDTH + x, i, max(d0, 0), max(d0, 0) + 5)
 
 
-@pytest.mark.parametrize(("name", "spp"), [("bose", 49), ("sobol", 32), ("zsobol", 16)])
+@pytest.mark.parametrize(("name", "spp"), [("bose", 49), ("sobol", 32), ("zsobol", 16), ("zfaure", 25)])
 def test_the_convenience_create_and_frames(cls, name, spp):
-    """Create(name, spp, width, height, seed) (dims not given, zsobol's image set by the class) gives the
-    same values; frame f uses the seed hash_pair(seed, f, 0x7f4a7c15) (the page's rule), frame 0 the seed."""
+    """Create(name, spp, width, height, seed) (dims not given, zsobol's and zfaure's image set by the
+    class) gives the same values; frame f uses the seed hash_pair(seed, f, 0x7f4a7c15) (the page's rule),
+    frame 0 the seed."""
     points = [(3, 4, 1, 0), (WIDTH - 1, 0, spp - 1, 7), (0, HEIGHT - 1, 0, -1)]
     seed = 0xFFFFFFFF  # pbrt's seed -1
     for frame in (0, 1, 12345):

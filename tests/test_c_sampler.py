@@ -26,6 +26,7 @@ import pyoa
 from pyoa import catalogue, c_headers
 from pyoa.catalogue.entries import OFFSETS
 from tests.test_c_headers import INCLUDE, WARN, compile_, need
+from tests.test_zfaure import VECTORS as ZFAURE_VECTORS
 
 SHIM = Path(__file__).parent / "c" / "sampler_shim.c"
 U32_MAX = 2**32 - 1
@@ -163,6 +164,30 @@ def test_zsobol_with_unknown_dims_and_sobol_with_all_dimensions(lib):
     assert got.view(np.uint32).tolist() == want.view(np.uint32).tolist()
 
 
+def test_zfaure_near_the_64_bit_limit(lib):
+    """zfaure at the count and image closest to its 64-bit limit: 1621^2 samples on a 1622 x 1622
+    image (k = 2, b^(2k) N = 0.98 * 2^64), the image's corners (top digits 0 and 1) at the first and
+    last samples, in three blocks; seeds 0 and 2 put an index T = z N + i past 2^63 (the reference's
+    pixel_code; tests/_opencl/test_kernels.py asserts it of the same shape)."""
+    b, side = 1621, 1622
+    options = dict(spp=b * b, dims=3 * b, resolution=(side, side))
+    corners = [y * side + x for x in (0, side - 1) for y in (0, side - 1)]
+    for seed in (0, 1, 2):
+        compare(lib, "zfaure", options, seed=seed, pixels=corners, samples=[0, 1, b * b - 1],
+                dims=[0, b - 1, b, 3 * b - 1])
+
+
+@pytest.mark.parametrize("vector", ZFAURE_VECTORS, ids=lambda v: f"b{v[0]}-N{v[1]}-px{v[4]}-j{v[8]}")
+def test_zfaure_spec_vectors(lib, vector):
+    """docs/spec.md section 5.12's test vectors (tests/test_zfaure.py reads them) from the C API, its
+    base resolved from the count."""
+    b, N, W, H, px, seed, z, i, j, want = vector
+    rc, msg, got, info = c_values(lib, "zfaure", spp=N, dims=j + 1, seed=seed, resolution=(W, H), pixels=[px],
+                                  samples=[i], dim_list=[j])
+    assert rc == 0, msg
+    assert info[3] == b and int(got.view(np.uint32)[0, 0, 0]) == want
+
+
 @pytest.mark.parametrize("name, options, error, shown", [
     ("bose", dict(spp=50, dims=3), "spp", ["49", "64"]),
     ("addelman-kempthorne", dict(spp=100, dims=3), "spp", ["98", "162"]),
@@ -171,6 +196,10 @@ def test_zsobol_with_unknown_dims_and_sobol_with_all_dimensions(lib):
     ("sobol", dict(spp=64, dims=3, offset="cmj"), "offset", []),
     ("no-such-sampler", dict(spp=16, dims=3), "name", ["bose"]),
     ("zsobol", dict(spp=16, dims=3), "resolution", []),
+    ("zfaure", dict(spp=30, dims=3, resolution=(8, 8)), "spp", ["27 (b=3), 32 (b=2)", "valid for faure"]),
+    ("zfaure", dict(spp=25, dims=3), "resolution", ["Morton order"]),
+    ("zfaure", dict(spp=25, dims=3, resolution=(8, 8), base=2), "base", ["are 5^2", "base 2 takes 4, 8, 16"]),
+    ("zfaure", dict(spp=4093**2, dims=3, resolution=(4094, 1)), "resolution", ["64-bit index"]),
     ("sobol", dict(spp=64, dims=3, jitter=0.5), "jitter", ["jittered2d"]),
     # the jitter is checked before the count, as in Python
     ("sobol", dict(spp=100, dims=3, jitter=0.5), "jitter", ["jittered2d"]),

@@ -32,8 +32,8 @@
  *   --offset NAME       the OAs' offset style (cmj, mj, j, centered)
  *   --jitter F          the jitter amount (default 1)
  *   --strength T        an OA's strength (0: the sampler's default)
- *   --base B            faure's base (0: its default)
- *   --resolution W H    the image (zsobol)
+ *   --base B            faure's or zfaure's base (0: its default)
+ *   --resolution W H    the image (zsobol, zfaure)
  *   --repeats R         timed launches after a warm-up (default 10; 0: one untimed launch)
  *   --host              compute the rectangle on the host instead (no CUDA call at all: the
  *                       tests run this where there is no GPU, to check the arguments, the layout

@@ -144,7 +144,7 @@ class Faure(CountRule):
         base = int(base)
         if base not in BASES:
             near = sorted(BASES, key=lambda b: (abs(b - base), b))[:2]
-            raise ValueError(f"faure: base must be a prime in [2, {MAX_BASE}], got {base}; nearest: "
+            raise ValueError(f"{self.name}: base must be a prime in [2, {MAX_BASE}], got {base}; nearest: "
                              f"{', '.join(map(str, sorted(near)))}")
         return FaureParams(N=params.N, b=base, m=_levels(base, params.N))
 

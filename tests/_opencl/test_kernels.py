@@ -83,6 +83,10 @@ __kernel void t_ak_cell(__global const uint *i, __global const uint *j, const ui
 { size_t g = get_global_id(0); uint a, b, ck; pyoa_addelman_kempthorne_cell(i[g], j[g], q, 2u, 2u * q, gf, tabled, ak, &a, &b, &ck);
   aij[g] = a; u[g] = b; }
 
+__kernel void t_zfaure(__global const uint *i, __global const uint *j, const uint N, const uint b, const uint k,
+                       const uint width, __global const uint *pixel, __global const uint *seed, __global float *out)
+{ size_t g = get_global_id(0); out[g] = pyoa_sample_zfaure(i[g], j[g], N, b, k, width, pixel[g], seed[g]); }
+
 __kernel void t_bb_cell(__global const uint *i, __global const uint *j, const uint s, __global const ushort *gf,
                         const uint tabled, __global uint *aij, __global uint *u)
 { size_t g = get_global_id(0); uint a, b, ck; pyoa_bose_bush_cell(i[g], j[g], s, 2u, 2u * s, gf, tabled, 0, &a, &b, &ck); aij[g] = a; u[g] = b; }
@@ -335,3 +339,40 @@ def test_index2_cells_are_the_plain_arrays(harness, field_args, ak_consts, name,
         assert np.array_equal(aij.reshape(N, d), A) and np.array_equal(u.reshape(N, d), U)
     assert np.array_equal(aij, want[0]) and np.array_equal(u, want[1])
     assert aij.max() < s and u.max() < 2 * s
+
+
+#: zfaure's shapes (N, b, width, height): one pixel; a non-square image in base 5; base 2's most index
+#: digits (k = 16, and 2^24 samples at k = 12: 48 digits); the largest base; the two closest to the
+#: 64-bit limit, b^(2k) N = 0.98 * 2^64 (1621^2 at k = 2) and 0.92 * 2^64 (137^3 at k = 3).
+ZFAURE_SHAPES = [(4, 2, 1, 1), (125, 5, 7, 3), (16, 2, 65536, 65536), (2**24, 2, 4096, 4096), (4093**2, 4093, 2, 2),
+                 (1621**2, 1621, 1622, 1622), (137**3, 137, 18770, 18770)]
+
+
+@pytest.mark.parametrize("N, b, width, height", ZFAURE_SHAPES)
+def test_zfaure_matches_numpy_with_64_bit_indices(harness, N, b, width, height):
+    """pyoa_sample_zfaure (zfaure.h: the order, the 64-bit index and its digits, the copies' hash chain,
+    faure.h's shared digit tail) against NumPy on random pixels, samples, dimensions (three blocks) and
+    seeds (0 among them), plus the image's corners at the first and last
+    sample. Near the limit some indices T = z N + i pass 2^63 (the reference's pixel_code says so),
+    so every bit of the uint64 arithmetic is exercised."""
+    from pyoa._numpy.zfaure import zfaure as np_zfaure
+    from pyoa.reference.zfaure import grid_digits, pixel_code, sequence_seed
+
+    k = grid_digits(b, width, height)
+    rng = np.random.default_rng(N + b + width)
+    n = 3000
+    i = rng.integers(0, N, n).astype(U32)
+    j = rng.integers(0, 3 * b, n).astype(U32)
+    pixel = rng.integers(0, width * height, n).astype(U32)
+    seed = rng.integers(0, 2**32, n, dtype=np.uint64).astype(U32)
+    seed[::7] = 0
+    corners = [(x, y) for x in (0, width - 1) for y in (0, height - 1)]
+    edge = [(y * width + x, smp, s) for x, y in corners for smp in (0, N - 1) for s in (0, 4, 9, U32_MAX)]
+    pixel, i, seed = (np.concatenate([a, np.array(e, U32)]) for a, e in zip((pixel, i, seed), zip(*edge)))
+    j = np.concatenate([j, np.arange(len(edge), dtype=U32) % (3 * b)])
+    got = harness("t_zfaure", [np.float32], i, j, U32(N), U32(b), U32(k), U32(width), pixel, seed)
+    assert_same_bits(got, np_zfaure(i, j, N, b, k, width, pixel, seed), f"zfaure N={N} b={b} {width}x{height}")
+    if b ** (2 * k) * N > 2**63:
+        top = max(pixel_code(int(p) % width, int(p) // width, b, k, sequence_seed(int(s), b)) * N + int(t)
+                  for p, t, s in zip(pixel, i, seed))
+        assert top >= 2**63

@@ -37,17 +37,17 @@
 
 /* What pyoa_solve and the others return: 0, or the kind of argument that
  * was refused. PYOA_ERROR_DIMS (dims above 2^20, or above halton's 6542
- * and sobol's 21201) and PYOA_ERROR_BASE (faure's base) have no other
- * code: the Python API refuses them with a ValueError of their own. */
+ * and sobol's 21201) and PYOA_ERROR_BASE (faure's and zfaure's base) have
+ * no other code: the Python API refuses them with a ValueError of their own. */
 enum {
     PYOA_OK = 0,
     PYOA_ERROR_NAME = 1,       /* no sampler of that name or alias */
     PYOA_ERROR_SPP = 2,        /* not a valid sample count of that sampler */
     PYOA_ERROR_STRENGTH = 3,   /* a strength the sampler cannot have */
     PYOA_ERROR_OFFSET = 4,     /* an unknown offset style, or one for a comparison sampler */
-    PYOA_ERROR_RESOLUTION = 5, /* zsobol without an image or too large a one; an image for another */
+    PYOA_ERROR_RESOLUTION = 5, /* zsobol or zfaure without an image or too large a one; an image for another */
     PYOA_ERROR_DIMS = 6,       /* more dimensions than the sampler has */
-    PYOA_ERROR_BASE = 7,       /* faure's base not a prime in [2, 4093]; a base for another sampler */
+    PYOA_ERROR_BASE = 7,       /* not a prime in [2, 4093] (zfaure: or not spp's); a base for another sampler */
     PYOA_ERROR_JITTER = 8      /* a jitter amount outside [0, 1], or one for a sampler without jitter */
 };
 
@@ -67,23 +67,25 @@ enum {
 #define PYOA_MAX_SPP 16777216u
 #define PYOA_MAX_DIMS 1048576u
 /* The codes PYOA_SAMPLER_<NAME> run from 0 to PYOA_SAMPLER_COUNT - 1. */
-#define PYOA_SAMPLER_COUNT 14u
+#define PYOA_SAMPLER_COUNT 15u
 /* pyoa_sampler_offset's offset of a comparison sampler: it has none (the
  * Python API's None). */
 #define PYOA_OFFSET_NONE 4u
 
 /* Resolved parameters of one sampler: pyoa.catalogue.entries.Params, plus
  * the sampler's code and its count. As there:
- *   s           coarse strata per axis (an OA's order; faure's base; the
- *               comparison samplers' grids as pyoa.catalogue.baselines documents);
- *   strength    t (0 for random, halton and sobol; faure: the largest m
- *               with s^m <= spp);
+ *   s           coarse strata per axis (an OA's order; faure's and zfaure's
+ *               base; the comparison samplers' grids as pyoa.catalogue.baselines
+ *               documents);
+ *   strength    t (0 for random, halton and sobol; faure and zfaure: the
+ *               largest m with s^m <= spp);
  *   block_dims  dimensions per independently randomized block;
  *   M           spp / s for the OAs (fine sub-strata per coarse stratum);
  *               the comparison samplers' own (spp, or cmj2d's n of m x n);
  *   dims        the dimensions asked for, 0 where unknown, as there: only
- *               the comparison samplers and faure keep it (0 for the OAs);
- *   width, height  the image of zsobol, 0 x 0 for the others. */
+ *               the comparison samplers, faure and zfaure keep it (0 for
+ *               the OAs);
+ *   width, height  the image of zsobol and zfaure, 0 x 0 for the others. */
 typedef struct pyoa_params {
     pyoa_u32 code, spp, s, strength, block_dims, M, dims, width, height;
 } pyoa_params;
@@ -271,13 +273,14 @@ PYOA_HOST_FN const char *pyoa_sampler_name(pyoa_u32 code)
     case PYOA_SAMPLER_ZSOBOL: return "zsobol";
     case PYOA_SAMPLER_PMJ02: return "pmj02";
     case PYOA_SAMPLER_FAURE: return "faure";
+    case PYOA_SAMPLER_ZFAURE: return "zfaure";
     default: return NULL;
     }
 }
 
 /* The k-th code in pyoa.catalogue.SAMPLERS's order (the OAs, then the
- * comparison samplers, then faure), k < PYOA_SAMPLER_COUNT: the order of
- * the name lists in messages and of the registry within a family. */
+ * comparison samplers, then faure and zfaure), k < PYOA_SAMPLER_COUNT: the
+ * order of the name lists in messages and of the registry within a family. */
 PYOA_HOST_FN pyoa_u32 pyoa_counts_listed(pyoa_u32 k)
 {
     switch (k) {
@@ -286,7 +289,7 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_listed(pyoa_u32 k)
     case 2: return PYOA_SAMPLER_CMJND;
     case 3: return PYOA_SAMPLER_ADDELMAN_KEMPTHORNE;
     case 4: return PYOA_SAMPLER_BOSE_BUSH;
-    default: return k; /* random (5) ... faure (13): their codes are their places */
+    default: return k; /* random (5) ... zfaure (14): their codes are their places */
     }
 }
 
@@ -383,19 +386,20 @@ PYOA_HOST_FN size_t pyoa_name_error(const char *name, char *message, size_t mess
 /* ------------------------------------------------------ what each entry is */
 
 /* The catalogue entry's family: 0 the orthogonal arrays (Construction.family
- * "oa"), 1 the comparison samplers ("baseline"), 2 faure ("progressive"). */
+ * "oa"), 1 the comparison samplers ("baseline"), 2 faure and zfaure
+ * ("progressive"). */
 PYOA_HOST_FN int pyoa_counts_family(pyoa_u32 code)
 {
-    return code <= PYOA_SAMPLER_BOSE_BUSH ? 0 : code == PYOA_SAMPLER_FAURE ? 2 : 1;
+    return code <= PYOA_SAMPLER_BOSE_BUSH ? 0 : code == PYOA_SAMPLER_FAURE || code == PYOA_SAMPLER_ZFAURE ? 2 : 1;
 }
 
 /* Whether sampler `code` needs the image (Construction.needs_resolution):
- * zsobol only. pyoa_solve refuses a width x height for every other, as the
- * Python API refuses resolution=, so a renderer passes
+ * zsobol and zfaure. pyoa_solve refuses a width x height for every other,
+ * as the Python API refuses resolution=, so a renderer passes
  * pyoa_needs_resolution(code) ? width : 0 (and the same for height). */
 PYOA_HOST_FN int pyoa_needs_resolution(pyoa_u32 code)
 {
-    return code == PYOA_SAMPLER_ZSOBOL;
+    return code == PYOA_SAMPLER_ZSOBOL || code == PYOA_SAMPLER_ZFAURE;
 }
 
 /* The comparison samplers' Baseline.max_dims: halton one prime below 2^16
@@ -429,6 +433,8 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_max_spp(pyoa_u32 code)
 #define PYOA_COUNTS_AK_LAST 2887u
 /* faure's largest base (reference.faure.MAX_BASE): the largest prime b with b^2 <= 2^24. */
 #define PYOA_COUNTS_MAX_BASE 4093u
+/* zfaure's largest image side (reference.zfaure.MAX_RESOLUTION), as zsobol's. */
+#define PYOA_COUNTS_MAX_RESOLUTION 65536u
 
 PYOA_HOST_FN void pyoa_counts_set(pyoa_params *p, pyoa_u32 code, pyoa_u32 spp, pyoa_u32 s, pyoa_u32 strength,
                                   pyoa_u32 block_dims, pyoa_u32 M, pyoa_u32 dims)
@@ -493,6 +499,56 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_levels(pyoa_u32 b, pyoa_u32 spp)
     return m;
 }
 
+/* Whether spp is a count of zfaure (catalogue.faure.zfaure_counts): b^m
+ * for a prime b and m >= 2, up to 2^24 (so b <= 4093). Then *b and *m are
+ * set: b is spp's smallest prime factor, and spp a power of it. */
+PYOA_HOST_FN int pyoa_counts_zfaure_power(pyoa_u32 spp, pyoa_u32 *b, pyoa_u32 *m)
+{
+    pyoa_u32 p, rest, e = 0u;
+    if (spp < 4u || spp > PYOA_MAX_SPP)
+        return 0;
+    for (p = 2u; p * p <= spp && spp % p != 0u; ++p) {
+    }
+    if (p * p > spp) /* spp is a prime: m = 1 */
+        return 0;
+    for (rest = spp; rest % p == 0u; rest /= p)
+        e++;
+    if (rest != 1u)
+        return 0;
+    *b = p;
+    *m = e;
+    return 1;
+}
+
+/* Whether spp is a count of zfaure (ZFaure.valid). */
+PYOA_HOST_FN int pyoa_counts_zfaure_valid(pyoa_u32 spp)
+{
+    pyoa_u32 b, m;
+    return pyoa_counts_zfaure_power(spp, &b, &m);
+}
+
+/* reference.zfaure.grid_digits: the fewest k with b^k >= max(width, height)
+ * (0 for one pixel). */
+PYOA_HOST_FN pyoa_u32 pyoa_counts_grid_digits(pyoa_u32 b, pyoa_u32 width, pyoa_u32 height)
+{
+    pyoa_u32 k = 0u, side = width > height ? width : height;
+    for (pyoa_u64 power = 1u; power < side; power *= b)
+        k++;
+    return k;
+}
+
+/* reference.zfaure.check_shape's 64-bit limit: whether b^(2k) N <= 2^64,
+ * exactly. b^k < b 2^16 <= 2^28, so x = b^(2k) < 2^56, and x N < 2^80 is
+ * summed in 32-bit halves: x N = hi 2^32 + lo with lo < 2^32. */
+PYOA_HOST_FN int pyoa_counts_zfaure_fits(pyoa_u32 N, pyoa_u32 b, pyoa_u32 k)
+{
+    const pyoa_u64 two32 = (pyoa_u64)1u << 32;
+    pyoa_u64 x = pyoa_counts_pow(b, 2u * k);
+    pyoa_u64 lo = (x & 0xffffffffu) * N, hi = (x >> 32) * N + (lo >> 32);
+    lo &= 0xffffffffu;
+    return hi < two32 || (hi == two32 && lo == 0u);
+}
+
 /* Baseline.params (and each subclass's) of a valid count. */
 PYOA_HOST_FN void pyoa_counts_baseline(pyoa_params *p, pyoa_u32 code, pyoa_u32 spp, pyoa_u32 dims)
 {
@@ -514,6 +570,12 @@ PYOA_HOST_FN void pyoa_counts_baseline(pyoa_params *p, pyoa_u32 code, pyoa_u32 s
     case PYOA_SAMPLER_FAURE:
         b = pyoa_counts_default_base(spp, dims);
         pyoa_counts_set(p, code, spp, b, pyoa_counts_levels(b, spp), b, spp, dims);
+        break;
+    case PYOA_SAMPLER_ZFAURE: /* ZFaure.params: the count fixes the base */
+        m = 0u;
+        b = 2u;
+        (void)pyoa_counts_zfaure_power(spp, &b, &m);
+        pyoa_counts_set(p, code, spp, b, m, b, spp, dims);
         break;
     default: /* halton, sobol: Baseline.params */
         pyoa_counts_set(p, code, spp, 1u, 0u, pyoa_counts_max_dims(code), spp, dims);
@@ -590,6 +652,8 @@ PYOA_HOST_FN int pyoa_counts_solve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 dims, p
             return -1;
         if (pyoa_counts_kind(code) == 2 && pyoa_counts_isqrt(spp) * pyoa_counts_isqrt(spp) != spp)
             return -1;
+        if (code == PYOA_SAMPLER_ZFAURE && !pyoa_counts_zfaure_valid(spp))
+            return -1; /* ZFaure.valid: b^m, b a prime, m >= 2 */
         pyoa_counts_baseline(out, code, spp, dims);
         return 0;
     }
@@ -747,6 +811,28 @@ PYOA_HOST_FN size_t pyoa_counts_candidates(pyoa_u32 code, pyoa_u32 spp, pyoa_u32
         }
         return n;
     }
+    if (code == PYOA_SAMPLER_ZFAURE) {
+        /* ZFaure.nearest over its counts, the prime powers b^m (m >= 2) of
+         * each base: the largest below spp, spp if one, the smallest above */
+        pyoa_u32 below = 0u, above = 0u, b;
+        for (b = 2u; b <= PYOA_COUNTS_MAX_BASE; ++b) {
+            pyoa_u64 power;
+            if (!pyoa_is_prime(b))
+                continue;
+            for (power = (pyoa_u64)b * b; power <= PYOA_MAX_SPP; power *= b) {
+                if (power < spp && power > below)
+                    below = (pyoa_u32)power;
+                if (power > spp && (above == 0u || power < above))
+                    above = (pyoa_u32)power;
+            }
+        }
+        for (x = 0u; x < 3u; ++x) {
+            pyoa_u32 count = x == 0u ? below : x == 1u ? spp : above;
+            if (count != 0u && (x != 1u || pyoa_counts_zfaure_valid(spp)))
+                pyoa_counts_baseline(&c[n++], code, count, dims);
+        }
+        return n;
+    }
     if (pyoa_counts_family(code) != 0 && pyoa_counts_kind(code) == 0) {
         /* every count in [1, max_spp]: spp's neighbours (Baseline.nearest) */
         max_spp = pyoa_counts_max_spp(code);
@@ -856,7 +942,7 @@ PYOA_HOST_FN int pyoa_counts_inner(pyoa_text *t, const pyoa_params *c)
         pyoa_text_char(t, 'x');
         pyoa_text_u32(t, c->M);
         return 1;
-    case PYOA_SAMPLER_FAURE:
+    case PYOA_SAMPLER_FAURE: case PYOA_SAMPLER_ZFAURE:
         pyoa_text_str(t, "b=");
         pyoa_text_u32(t, c->s);
         return 1;
@@ -955,6 +1041,9 @@ PYOA_HOST_FN void pyoa_counts_invalid(pyoa_text *t, pyoa_u32 code, pyoa_u32 spp,
     case PYOA_SAMPLER_JITTERED2D:
         pyoa_text_str(t, " is not a square m^2 (m <= 4096)");
         return;
+    case PYOA_SAMPLER_ZFAURE:
+        pyoa_text_str(t, " is not a power b^m of a prime b with m >= 2 (4, 8, 9, 16, 25, 27, 32, ...) up to 2^24");
+        return;
     default:
         if (pyoa_counts_kind(code) == 1) {
             pyoa_text_str(t, " is not a power of two in [1, 2^");
@@ -1032,8 +1121,8 @@ PYOA_HOST_FN int pyoa_offset_code(const char *offset, pyoa_u32 *code)
 }
 
 /* samplers._offset: the offset of sampler `sampler_code` given `offset`.
- * The OA samplers: pyoa_offset_code's; the comparison samplers and faure
- * have none: NULL gives PYOA_OFFSET_NONE, anything else is refused. On
+ * The OA samplers: pyoa_offset_code's; the comparison samplers, faure and
+ * zfaure have none: NULL gives PYOA_OFFSET_NONE, anything else is refused. On
  * error (PYOA_ERROR_OFFSET; PYOA_ERROR_NAME for a code that is no sampler)
  * the Python API's message goes to message[message_size]. */
 PYOA_HOST_FN int pyoa_sampler_offset(pyoa_u32 sampler_code, const char *offset, pyoa_u32 *code, char *message,
@@ -1069,6 +1158,68 @@ PYOA_HOST_FN int pyoa_sampler_offset(pyoa_u32 sampler_code, const char *offset, 
     }
     pyoa_text_str(&t, " (default 'cmj')");
     return PYOA_ERROR_OFFSET;
+}
+
+/* ------------------------------------------------------- zfaure's shape */
+
+/* reference.zfaure.check_shape's last check, for a valid count N and base
+ * b: 1 if the padded grid's b^(2k) pixels times N samples fit the 64-bit
+ * index, else 0 with its message. */
+PYOA_HOST_FN int pyoa_counts_zfaure_shape(pyoa_text *t, pyoa_u32 N, pyoa_u32 b, pyoa_u32 width, pyoa_u32 height)
+{
+    pyoa_u32 k = pyoa_counts_grid_digits(b, width, height);
+    if (pyoa_counts_zfaure_fits(N, b, k))
+        return 1;
+    pyoa_text_str(t, "zfaure: a ");
+    pyoa_text_u32(t, width);
+    pyoa_text_str(t, " x ");
+    pyoa_text_u32(t, height);
+    pyoa_text_str(t, " image in base ");
+    pyoa_text_u32(t, b);
+    pyoa_text_str(t, " pads to a ");
+    pyoa_text_u32(t, b);
+    pyoa_text_char(t, '^');
+    pyoa_text_u32(t, k);
+    pyoa_text_str(t, " x ");
+    pyoa_text_u32(t, b);
+    pyoa_text_char(t, '^');
+    pyoa_text_u32(t, k);
+    pyoa_text_str(t, " grid, and ");
+    pyoa_text_u32(t, b);
+    pyoa_text_char(t, '^');
+    pyoa_text_u32(t, 2u * k);
+    pyoa_text_str(t, " pixels x ");
+    pyoa_text_u32(t, N);
+    pyoa_text_str(t, " samples pass the 64-bit index (at most 2^64); use a smaller base, image or count");
+    return 0;
+}
+
+/* ZFaure.with_base's message for a prime `base` other than the count's
+ * own, N = b^m: the first six counts of that base (b^2, b^3, ...). */
+PYOA_HOST_FN void pyoa_counts_zfaure_base_error(pyoa_text *t, pyoa_u32 N, pyoa_u32 b, pyoa_u32 m, pyoa_u32 base)
+{
+    pyoa_u64 power = (pyoa_u64)base * base;
+    pyoa_u32 shown = 0u;
+    pyoa_text_str(t, "zfaure: ");
+    pyoa_text_u32(t, N);
+    pyoa_text_str(t, " samples are ");
+    pyoa_text_u32(t, b);
+    pyoa_text_char(t, '^');
+    pyoa_text_u32(t, m);
+    pyoa_text_str(t, ", base ");
+    pyoa_text_u32(t, b);
+    pyoa_text_str(t, "; base ");
+    pyoa_text_u32(t, base);
+    pyoa_text_str(t, " takes ");
+    for (; power <= PYOA_MAX_SPP; power *= base) {
+        if (shown == 6u) {
+            pyoa_text_str(t, ", ...");
+            break;
+        }
+        pyoa_text_str(t, shown++ ? ", " : "");
+        pyoa_text_u32(t, (pyoa_u32)power);
+    }
+    pyoa_text_str(t, " (the count fixes the base: give one of these counts, or no base)");
 }
 
 /* ---------------------------------------------------------------- solving */
@@ -1139,38 +1290,44 @@ PYOA_HOST_FN int pyoa_counts_resolve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 stren
         pyoa_counts_elsewhere(&t, code, spp, dims);
         return PYOA_ERROR_SPP;
     }
-    /* with_resolution: zsobol needs width x height, each in [1, 2^16]; the
-     * others refuse one (width = height = 0 is none) */
+    /* with_resolution: zsobol and zfaure need width x height, each in
+     * [1, 2^16]; the others refuse one (width = height = 0 is none) */
     if (!pyoa_needs_resolution(code) && (width != 0u || height != 0u)) {
         pyoa_text_str(&t, name);
         pyoa_text_str(&t, " takes no resolution (got resolution=(");
         pyoa_text_u32(&t, width);
         pyoa_text_str(&t, ", ");
         pyoa_text_u32(&t, height);
-        pyoa_text_str(&t, ")); only zsobol depends on where a pixel lies in the image");
+        pyoa_text_str(&t, ")); only zsobol, zfaure depend on where a pixel lies in the image");
         return PYOA_ERROR_RESOLUTION;
     }
     if (pyoa_needs_resolution(code)) {
+        int bad_width = width < 1u || width > PYOA_COUNTS_MAX_RESOLUTION;
         if (width == 0u && height == 0u) {
-            pyoa_text_str(&t, "zsobol needs the image: resolution=(width, height), each in [1, 65536] (its "
-                              "Z-order curve spans the image; pixels are numbered row-major, y * width + x)");
+            pyoa_text_str(&t, name);
+            pyoa_text_str(&t, " needs the image: resolution=(width, height), each in [1, 65536] (");
+            pyoa_text_str(&t, code == PYOA_SAMPLER_ZSOBOL ? "its Z-order curve spans the image"
+                                                          : "its Morton order spans the image");
+            pyoa_text_str(&t, "; pixels are numbered row-major, y * width + x)");
             return PYOA_ERROR_RESOLUTION;
         }
-        if (width < 1u || width > 65536u || height < 1u || height > 65536u) {
-            pyoa_text_str(&t, width < 1u || width > 65536u ? "resolution width" : "resolution height");
+        if (bad_width || height < 1u || height > PYOA_COUNTS_MAX_RESOLUTION) {
+            pyoa_text_str(&t, bad_width ? "resolution width" : "resolution height");
             pyoa_text_str(&t, " must be in [1, 65536], got ");
-            pyoa_text_u32(&t, width < 1u || width > 65536u ? width : height);
+            pyoa_text_u32(&t, bad_width ? width : height);
             return PYOA_ERROR_RESOLUTION;
         }
+        if (code == PYOA_SAMPLER_ZFAURE && !pyoa_counts_zfaure_shape(&t, p.M, p.s, width, height))
+            return PYOA_ERROR_RESOLUTION;
         p.width = width;
         p.height = height;
     }
-    /* with_base: faure's prime base; the others refuse one (0 is none) */
-    if (base != 0u && code != PYOA_SAMPLER_FAURE) {
+    /* with_base: faure's and zfaure's prime base; the others refuse one (0 is none) */
+    if (base != 0u && pyoa_counts_family(code) != 2) {
         pyoa_text_str(&t, name);
         pyoa_text_str(&t, " takes no base (got base=");
         pyoa_text_u32(&t, base);
-        pyoa_text_str(&t, "); only faure has a digit base");
+        pyoa_text_str(&t, "); only faure, zfaure have a digit base");
         return PYOA_ERROR_BASE;
     }
     if (base != 0u) {
@@ -1188,12 +1345,18 @@ PYOA_HOST_FN int pyoa_counts_resolve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 stren
                                  && (na >= 2u || above[na] == 0u || base - below[nb] <= above[na] - base);
                 pick[k] = take_below ? below[nb++] : above[na++];
             }
-            pyoa_text_str(&t, "faure: base must be a prime in [2, 4093], got ");
+            /* Faure.with_base's message, which zfaure inherits */
+            pyoa_text_str(&t, name);
+            pyoa_text_str(&t, ": base must be a prime in [2, 4093], got ");
             pyoa_text_u32(&t, base);
             pyoa_text_str(&t, "; nearest: ");
             pyoa_text_u32(&t, pick[0] < pick[1] ? pick[0] : pick[1]);
             pyoa_text_str(&t, ", ");
             pyoa_text_u32(&t, pick[0] < pick[1] ? pick[1] : pick[0]);
+            return PYOA_ERROR_BASE;
+        }
+        if (code == PYOA_SAMPLER_ZFAURE && base != p.s) { /* the count fixes the base */
+            pyoa_counts_zfaure_base_error(&t, p.M, p.s, p.strength, base);
             return PYOA_ERROR_BASE;
         }
         p.s = base;
@@ -1214,8 +1377,9 @@ PYOA_HOST_FN int pyoa_counts_resolve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 stren
  *             default base ignores dims, jittered2d's last dimension is
  *             never a lone one, and halton's and sobol's limits are not
  *             checked); at most 2^20;
- *   width, height  zsobol's image, each in [1, 65536]; 0, 0 for every other
- *             sampler (which refuses an image, as the Python API does).
+ *   width, height  zsobol's and zfaure's image, each in [1, 65536]; 0, 0
+ *             for every other sampler (which refuses an image, as the Python
+ *             API does).
  * Returns PYOA_OK, or the error code with the Python API's message in
  * message[message_size] (NULL allowed; snprintf's truncation): an invalid
  * count gives "bose: 120 is not s^2 ...; nearest: 81 (s=9), 121 (s=11); 120
@@ -1230,11 +1394,12 @@ PYOA_HOST_FN int pyoa_solve(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 strength, pyoa
                                message_size);
 }
 
-/* pyoa_solve with faure's `base` (pyoa.sampler(..., base=)): 0 is the
- * default (progressive.default_base: the largest prime b with b^2 <= spp,
- * or the smallest prime >= dims when that is no larger); else a prime in
- * [2, 4093], out->s = out->block_dims = base and out->strength the largest
- * m with base^m <= spp. Any other sampler refuses a base (PYOA_ERROR_BASE),
+/* pyoa_solve with faure's or zfaure's `base` (pyoa.sampler(..., base=)): 0
+ * is the default (faure: progressive.default_base, the largest prime b with
+ * b^2 <= spp, or the smallest prime >= dims when that is no larger; zfaure:
+ * the count's, spp = b^m); else a prime in [2, 4093] (zfaure: the count's
+ * own), out->s = out->block_dims = base and out->strength the largest m
+ * with base^m <= spp. Any other sampler refuses a base (PYOA_ERROR_BASE),
  * as the Python API does. */
 PYOA_HOST_FN int pyoa_solve_base(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 strength, pyoa_u32 dims, pyoa_u32 base,
                                  pyoa_u32 width, pyoa_u32 height, pyoa_params *out, char *message, size_t message_size)
@@ -1247,7 +1412,7 @@ PYOA_HOST_FN int pyoa_solve_base(pyoa_u32 code, pyoa_u32 spp, pyoa_u32 strength,
  * resolution=, base=) checks, in its order, with its messages: the name
  * (catalogue name or alias, any case), spp, dims (0: unknown, see
  * pyoa_solve), the offset (pyoa_sampler_offset: NULL the default; the
- * comparison samplers and faure refuse one), the jitter amount (1: the
+ * comparison samplers, faure and zfaure refuse one), the jitter amount (1: the
  * default; PYOA_ERROR_JITTER), the strength and count, the
  * resolution, the base. On success *out and *offset_code (which may be
  * NULL) are written: the offset's PYOA_OFFSET_<NAME>, PYOA_OFFSET_NONE for
@@ -1297,7 +1462,8 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_index_digits(pyoa_u32 b, pyoa_u32 n)
 }
 
 /* The entry's shape_args(params), zero-padded to three (what the OpenCL
- * backend passes its kernels as a, b, c, pyoa/_opencl/backend.py):
+ * backend passes its kernels as a, b, c, pyoa/_opencl/backend.py; zfaure's
+ * four packed into three):
  *   bose, addelman-kempthorne, bose-bush   (s)
  *   bush, cmjnd                            (s, t)
  *   random, halton, sobol                  ()
@@ -1312,6 +1478,12 @@ PYOA_HOST_FN pyoa_u32 pyoa_counts_index_digits(pyoa_u32 b, pyoa_u32 n)
  *                                          index spp - 1, so valid for every
  *                                          sample of the sampler (any n with
  *                                          b^n > i gives sample i's value)
+ *   zfaure                                 (spp, b | k << 16, width): its
+ *                                          four (spp, b, k, width), k the
+ *                                          digits of the image's padded
+ *                                          b^k x b^k grid, as the three words
+ *                                          of its launch (ZFaure.launch; b <
+ *                                          2^12, k <= 16)
  * The OA samplers' kernel also takes block_dims, s * M, M and the offset
  * (generate.cl), which pyoa_params holds. */
 PYOA_HOST_FN void pyoa_shape_args(const pyoa_params *p, pyoa_u32 *a, pyoa_u32 *b, pyoa_u32 *c)
@@ -1329,6 +1501,11 @@ PYOA_HOST_FN void pyoa_shape_args(const pyoa_params *p, pyoa_u32 *a, pyoa_u32 *b
         *c = p->width;
         break;
     case PYOA_SAMPLER_FAURE: *a = p->s; *b = pyoa_counts_index_digits(p->s, p->M); break;
+    case PYOA_SAMPLER_ZFAURE:
+        *a = p->M;
+        *b = p->s | pyoa_counts_grid_digits(p->s, p->width, p->height) << 16;
+        *c = p->width;
+        break;
     default: break;
     }
 }

@@ -22,6 +22,40 @@ PYOA_FN pyoa_u32 pyoa_faure_digits(pyoa_u32 b)
     return K;
 }
 
+/* Coordinate col of the index whose base-b digits are a[0 .. n-1] (least
+ * significant first, after any index scramble), Owen-scrambled with seed q
+ * (0: unscrambled): the Taylor shift, the nested output scramble and the
+ * float rule, shared by faure and zfaure (pyoa/zfaure.h) as
+ * reference.faure.digits_value is. a is overwritten. */
+PYOA_FN float pyoa_faure_digits_value(pyoa_u32 *a, pyoa_u32 n, pyoa_u32 b, pyoa_u32 col, pyoa_u32 q)
+{
+    pyoa_u32 prefix = 0u;
+    pyoa_u64 numer = 0u, power = 1u, fine, x24, lo;
+    /* a becomes the coefficients of A(x + col) mod b: y_k = a[k]
+     * (repeated synthetic division; products stay below b^2 <= 2^24).
+     * Step k fixes y_k, and only y_0 .. y_(K-1) are read: the steps stop
+     * at k = K (b^k >= 2^24), which only zfaure's longer indices reach */
+    for (pyoa_u32 k = 0u; k + 1u < n && power < 0x1000000u; k++, power *= b)
+        for (pyoa_u32 r = n - 1u; r-- > k;)
+            a[r] = (a[r] + col * a[r + 1u]) % b;
+    /* nested scrambling of the K output digits, b^K >= 2^24; power = b^k,
+     * prefix = (y_0 ... y_{k-1}) in base b */
+    power = 1u;
+    for (pyoa_u32 k = 0u; power < 0x1000000u; k++) {
+        pyoa_u32 y = k < n ? a[k] : 0u;
+        pyoa_u32 yy = q ? pyoa_permute(y, b, pyoa_hash_pair(q, (pyoa_u32)power + prefix, PYOA_FAURE_DIGIT_KEY)) : y;
+        numer = numer * b + yy;
+        prefix = prefix * b + y;
+        power *= b;
+    }
+    /* the cell clamp: keep the 24-bit value in its cell of b^-L, b^L <= 2^24
+     * (L = K for b = 2, where b^K = 2^24, else K - 1) */
+    fine = power == 0x1000000u ? power : power / b;
+    x24 = (numer << 24) / power;
+    lo = (((numer / (power / fine)) << 24) + fine - 1u) / fine;
+    return PYOA_MUL(PYOA_U32_TO_F32((pyoa_u32)PYOA_MAX(x24, lo)), PYOA_2POW_M24);
+}
+
 /* Sample i, dimension j in base b, of the sequence with seed p, with the
  * Taylor shift over the n lowest digits of i: any n with i < b^n and
  * n <= pyoa_faure_digits(b) gives the same value (the digits above i's are
@@ -31,10 +65,8 @@ PYOA_FN float pyoa_sample_faure(pyoa_u32 i, pyoa_u32 j, pyoa_u32 b, pyoa_u32 n, 
 {
     pyoa_u32 col = j % b, block = j / b;
     pyoa_u32 P = pyoa_block_seed(p, block);
-    pyoa_u32 q = pyoa_derived_seed(P, col, PYOA_FAURE_KEY);
     pyoa_u32 a[PYOA_FAURE_MAX_DIGITS];
-    pyoa_u32 rest = i, prefix = 0u;
-    pyoa_u64 numer = 0u, power = 1u, fine, x24, lo;
+    pyoa_u32 rest = i;
     if (block) /* a copy: all K digits of its nested-scrambled index */
         n = pyoa_faure_digits(b);
     for (pyoa_u32 r = 0u; r < n; r++) {
@@ -52,26 +84,7 @@ PYOA_FN float pyoa_sample_faure(pyoa_u32 i, pyoa_u32 j, pyoa_u32 b, pyoa_u32 n, 
             pw *= b;
         }
     }
-    /* a becomes the coefficients of A(x + col) mod b: y_k = a[k]
-     * (repeated synthetic division; products stay below b^2 <= 2^24) */
-    for (pyoa_u32 k = 0u; k + 1u < n; k++)
-        for (pyoa_u32 r = n - 1u; r-- > k;)
-            a[r] = (a[r] + col * a[r + 1u]) % b;
-    /* nested scrambling of the K output digits, b^K >= 2^24; power = b^k,
-     * prefix = (y_0 ... y_{k-1}) in base b */
-    for (pyoa_u32 k = 0u; power < 0x1000000u; k++) {
-        pyoa_u32 y = k < n ? a[k] : 0u;
-        pyoa_u32 yy = q ? pyoa_permute(y, b, pyoa_hash_pair(q, (pyoa_u32)power + prefix, PYOA_FAURE_DIGIT_KEY)) : y;
-        numer = numer * b + yy;
-        prefix = prefix * b + y;
-        power *= b;
-    }
-    /* the cell clamp: keep the 24-bit value in its cell of b^-L, b^L <= 2^24
-     * (L = K for b = 2, where b^K = 2^24, else K - 1) */
-    fine = power == 0x1000000u ? power : power / b;
-    x24 = (numer << 24) / power;
-    lo = (((numer / (power / fine)) << 24) + fine - 1u) / fine;
-    return PYOA_MUL(PYOA_U32_TO_F32((pyoa_u32)PYOA_MAX(x24, lo)), PYOA_2POW_M24);
+    return pyoa_faure_digits_value(a, n, b, col, pyoa_derived_seed(P, col, PYOA_FAURE_KEY));
 }
 
 #endif /* PYOA_FAURE_H */

@@ -30,6 +30,10 @@
 #define PYOA_SUBSTRATUM_KEY 0x68bc21ebu
 #define PYOA_SUBX_KEY 0x68bc21ebu
 #define PYOA_SUBY_KEY 0x02e5be93u
+#define PYOA_ZFAURE_AXIS_KEY 0xbb67ae85u
+#define PYOA_ZFAURE_INDEX_KEY 0x5be0cd19u
+#define PYOA_ZFAURE_ORDER_KEY 0x6a09e667u
+#define PYOA_ZFAURE_TILE_KEY 0x9b05688cu
 #define PYOA_ZSOBOL_KEY 0xb5297a4du
 
 /* The catalogue's codes (pyoa.catalogue: each sampler's `code`; pyoa.catalogue.entries.OFFSET_CODES). */
@@ -47,6 +51,7 @@
 #define PYOA_SAMPLER_ZSOBOL 11u
 #define PYOA_SAMPLER_PMJ02 12u
 #define PYOA_SAMPLER_FAURE 13u
+#define PYOA_SAMPLER_ZFAURE 14u
 #define PYOA_OFFSET_CENTERED 0u
 #define PYOA_OFFSET_J 1u
 #define PYOA_OFFSET_MJ 2u

@@ -29,8 +29,8 @@
  * index (docs/spec.md section 3.1: the pixel's seed is a hash of the user
  * seed and that index). pyoa_pixel_index(x, y, width) = y * width + x over
  * the full image, so a crop or tile reproduces the full frame's values.
- * zsobol reads the position itself (its Morton order): give it the image
- * size in the options and use the same index. For animations, give each
+ * zsobol and zfaure read the position itself (their Morton orders): give
+ * them the image size in the options and use the same index. For animations, give each
  * frame its own seed (docs/renderers.md has the recommended rule).
  *
  * Host-only functions are PYOA_HOST_FN; pyoa_sampler_value and
@@ -58,8 +58,8 @@ typedef struct pyoa_options {
     const char *offset; /* the OAs' offset style: "cmj" (NULL: the default), "mj", "j" or "centered" */
     float jitter;       /* jitter amount in [0, 1] (1: the default; OAs, jittered2d and cmj2d only) */
     pyoa_u32 strength;  /* an OA's strength t; 0: the sampler's default */
-    pyoa_u32 base;      /* faure's prime base; 0: its default */
-    pyoa_u32 width;     /* the image, for zsobol (0 x 0 for the others) */
+    pyoa_u32 base;      /* faure's and zfaure's prime base; 0: its default */
+    pyoa_u32 width;     /* the image, for zsobol and zfaure (0 x 0 for the others) */
     pyoa_u32 height;
 } pyoa_options;
 
@@ -89,7 +89,7 @@ typedef struct pyoa_sampler {
     pyoa_u32 dims;        /* as given (0: not known) */
     pyoa_u32 seed;        /* the user seed */
     pyoa_u32 s, strength, block_dims, M; /* the resolved parameters (pyoa/counts.h pyoa_params) */
-    pyoa_u32 a, b, c;     /* the shape arguments of the comparison samplers (pyoa_shape_args) */
+    pyoa_u32 a, b, c;     /* the shape arguments of the comparison and progressive samplers (pyoa_shape_args) */
     pyoa_u32 offset;      /* PYOA_OFFSET_<NAME>; PYOA_OFFSET_NONE for the others */
     float jitter;         /* J */
     pyoa_u32 field;       /* the order of the OA's Galois field (0: none) */

@@ -143,8 +143,8 @@ class BasicSampler {
     /* The same from the C API's options (pyoa_options_default, then dims,
      * offset, jitter, strength, base, seed as needed). width x height is
      * the full image: the class numbers pixels by its width, and the
-     * options get it where the sampler needs it (zsobol; the C API refuses
-     * an image for the others, so theirs stay 0 x 0). */
+     * options get it where the sampler needs it (zsobol, zfaure; the C API
+     * refuses an image for the others, so theirs stay 0 x 0). */
     template <class Allocate>
     static Status Create(BasicSampler &out, pyoa_options options, int width, int height, Allocate allocate)
     {
