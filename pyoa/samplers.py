@@ -311,9 +311,10 @@ class Sampler:
     samplers (``random``, ``jittered2d``, ``cmj2d``, ``sobol02``, ``halton``,
     ``sobol``) and pbrt-v4's ``zsobol`` (Z-order Sobol, blue-noise error
     across pixels; needs ``resolution``) and ``pmj02`` (progressive
-    multi-jittered (0,2)), and pyoa's progressive ``faure`` (Owen-scrambled
+    multi-jittered (0,2)), pyoa's progressive ``faure`` (Owen-scrambled
     Faure (0,s)-sequences: orthogonal arrays at every ``b**m``, any count)
-    share this class, its API and its bit-exactness guarantees.
+    and ``zfaure`` (one Faure sequence ordered across the image: blue-noise
+    error in every dimension of a block; needs ``resolution``) share this class, its API and its bit-exactness guarantees.
 
     Create one with :func:`sampler`. Immutable (setting or deleting an
     attribute raises AttributeError: make a new sampler instead) and safe to
@@ -347,9 +348,9 @@ class Sampler:
         User seed (uint32).
     resolution : tuple of int or None
         ``(width, height)`` of the image for the samplers whose values depend
-        on where a pixel lies in it (``zsobol``), else None.
+        on where a pixel lies in it (``zsobol``, ``zfaure``), else None.
     base : int or None
-        The prime digit base of ``faure`` (given or its default), else None.
+        The prime digit base of ``faure`` or ``zfaure`` (given or its default), else None.
     n_pixels : int
         How many pixel indices are valid: ``width * height`` with a
         resolution (pixel ``y * width + x``), else ``2**32``.
@@ -868,7 +869,11 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         orthogonal arrays: ``"faure"`` (Owen-scrambled Faure (0,s)-sequence
         in a prime base, any ``spp``: every aligned block of ``b**m`` samples
         a (0,m,b)-net, so ``b**2`` samples are a strength-2 array and a
-        render can stop and continue at any count). See :func:`samplers`,
+        render can stop and continue at any count) and ``"zfaure"`` (one
+        such sequence handed out along a scrambled Morton order of the image,
+        ``spp = b**m`` with ``m >= 2``: each pixel a (0,m,b)-net, each tile of
+        ``b x b`` pixels a (0,m+2,b)-net, so the error is blue noise in every
+        dimension of a block; needs `resolution`). See :func:`samplers`,
         :func:`valid_spp` and ``docs/samplers.md``.
     spp : int
         Samples per pixel. An invalid count raises a ValueError naming the
@@ -895,17 +900,19 @@ def sampler(name: str, *, spp: int, dims: int, seed: int = 0, offset: str | None
         ``t <= dims`` (``t >= 2``) for which ``spp`` is a perfect t-th power.
     resolution : (int, int), optional
         ``(width, height)`` of the image, required by the samplers whose
-        values depend on where a pixel lies in the image (``zsobol``: its
-        Morton order spans the image) and refused by the others. Pixels are
+        values depend on where a pixel lies in the image (``zsobol``,
+        ``zfaure``: their Morton orders span the image) and refused by the
+        others. Pixels are
         then numbered row-major, ``pixel = y * width + x`` (as pyoa's
         renderer numbers them), and must be below ``width * height``.
     base : int, optional
-        ``faure`` only (the others refuse it): its digit base, a prime in
-        ``[2, 4093]``; ``b`` dimensions per block, every ``b**m`` samples a
-        net. Default: the largest prime ``b`` with ``b**2 <= spp``, or the
-        smallest prime ``>= dims`` if smaller (see :class:`pyoa.catalogue.faure.Faure`).
-        A pixel's samples do not depend on ``spp`` for a given base: give it
-        to continue a sequence at another count.
+        ``faure`` and ``zfaure`` only (the others refuse it): the digit base,
+        a prime in ``[2, 4093]``; ``b`` dimensions per block, every ``b**m``
+        samples a net. ``faure``'s default: the largest prime ``b`` with
+        ``b**2 <= spp``, or the smallest prime ``>= dims`` if smaller (see
+        :class:`pyoa.catalogue.faure.Faure`); a pixel's samples do not depend
+        on ``spp`` for a given base: give it to continue a sequence at another
+        count. ``zfaure``'s count ``b**m`` fixes it.
     backend : {"opencl", "numpy"}, optional
         Default: ``$PYOA_BACKEND``, else OpenCL if usable, else NumPy with a
         warning (see :mod:`pyoa.backends`).

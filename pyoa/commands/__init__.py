@@ -3,7 +3,8 @@
 ``pyoa points``   generate a point set and save it (.npy or .csv)
 ``pyoa samplers`` list the samplers, ``pyoa spp NAME`` their valid sample counts
 ``pyoa backends`` report the usable backends and OpenCL devices
-``pyoa plot``     every 2D projection of a point set; ``pyoa spectrum`` its power spectrum
+``pyoa plot``     every 2D projection of a point set; ``pyoa spectrum`` its power spectrum,
+                  or with ``--error`` the screen-space spectrum of a sampler's integration error
 ``pyoa render``   render a scene (EXR/PNG); ``pyoa compare`` tabulate samplers'
                   relative MSE against a reference; ``pyoa reference`` render one
 ``pyoa study``    error against spp over seeds, with confidence intervals

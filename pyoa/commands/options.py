@@ -30,9 +30,11 @@ conventions, the same in every command:
             sampler that cannot have {DEFAULT_SPP} takes its nearest valid count and says so; a --spp you
             give is refused with the nearest valid counts, except by compare and study, which take
             each sampler's nearest and show it in their tables.
-  --dims    always a number of dimensions; spectrum's pair of dimensions is --pair I,J.
-  --size    W H of an image (render, compare, reference, study); compare and study take their
-            reference's size when --size is not given, and refuse a --size that differs from it.
+  --dims    always a number of dimensions (spectrum --error: its integrand's); spectrum's pair of
+            dimensions is --pair I,J.
+  --size    W H of an image (render, compare, reference, study, spectrum --error: square); compare
+            and study take their reference's size when --size is not given, and refuse a --size
+            that differs from it.
             A figure's width in pixels (plot, spectrum) is --figure-width PX.
   --reference  one image (render, compare); a study's, one per scene: --reference SCENE=FILE,
             repeated (FILE alone when the study has one scene), before or after the scenes.

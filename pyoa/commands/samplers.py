@@ -4,16 +4,20 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import inspect
 import time
 
 import numpy as np
 
 from .. import OFFSETS, backends, sampler, samplers, valid_spp
+from ..analysis import error_spectrum
+from ..analysis.integrands import INTEGRANDS
 from ..util.atomic import atomic_path
 from ..catalogue import get
-from ..catalogue.entries import MAX_DIMS, MAX_UINT32, SppChoice
+from ..catalogue.entries import MAX_DIMS, MAX_UINT32, SppChoice, check_int
 from ..plots import FIGURE_WIDTH
-from ..samplers import trial_options
+from ..samplers import TRIAL_RESOLUTION, trial_options
 from ..util.units import format_rate
 from .options import (DEFAULT_SPP, add_sampling_options, check_out, deprecated, figure_width, int_option,
                       resolve_spp, suffix)
@@ -21,6 +25,17 @@ from .options import (DEFAULT_SPP, add_sampling_options, check_out, deprecated, 
 FORMATS = (".npy", ".csv")
 #: Values per block of CSV rows written at once (bounds the float64 table).
 CSV_BLOCK_VALUES = 1 << 22
+#: ``--resolution``'s help (points, plot, spectrum).
+RESOLUTION_HELP = ("image size of a sampler that needs one (zsobol, zfaure; pixels row-major, y*W + x); "
+                   "default 65536 65536")
+#: ``pyoa spectrum``'s randomizations averaged and largest frequency shown, without --trials, --freq.
+TRIALS, FREQ = 64, 48
+#: ``pyoa spectrum --error``'s defaults: :func:`pyoa.analysis.error_spectrum`'s own.
+ERROR_DEFAULTS = {name: p.default for name, p in inspect.signature(error_spectrum).parameters.items()
+                  if name in ("size", "seeds", "integrand", "dims")}
+#: The ranges :func:`pyoa.analysis.error_spectrum` takes (it checks them too, naming its keywords; the command
+#: checks them first so that the message names the option as typed; tests/test_zfaure_cli.py holds them equal).
+ERROR_LIMITS = {"size": (8, 1024), "seeds": (1, 1024), "dims": (1, 64)}
 
 
 def save_points(x: np.ndarray, path: str, pixels: range) -> None:
@@ -85,7 +100,9 @@ def cmd_points(args) -> int:
     options = {"offset": args.offset, "jitter": args.jitter, "strength": args.strength, "backend": args.backend,
                "device": args.device, "resolution": tuple(args.resolution) if args.resolution else None,
                "base": args.base}
-    smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, **trial_options(args.sampler, options))
+    with _default_image_named(args):
+        smp = sampler(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed,
+                      **trial_options(args.sampler, options))
     # One value first: it pays the one-time costs (the backend's kernel build, a table such as pmj02's,
     # built once and cached), so that the rate below is the generation's alone, as render's is.
     t0 = time.perf_counter()
@@ -147,25 +164,55 @@ def _options(args) -> dict:
         opts["strength"] = args.strength
     if args.base is not None:
         opts["base"] = args.base
+    if args.resolution is not None:
+        opts["resolution"] = tuple(args.resolution)
     return opts
+
+
+@contextlib.contextmanager
+def _default_image_named(args):
+    """A sampler that needs the image (zsobol, zfaure) and was given no ``--resolution`` reads its
+    pixels in the default image, 65536 x 65536 (:data:`pyoa.samplers.TRIAL_RESOLUTION`, as every
+    command's): where the sampler refuses that image (zfaure's 64-bit index at a large base and
+    count), its message gains the option that chooses a smaller one."""
+    try:
+        yield
+    except ValueError as exc:
+        default = "{} x {}".format(*TRIAL_RESOLUTION)
+        if args.resolution is None and get(args.sampler).needs_resolution and f"{default} image" in str(exc):
+            raise ValueError(f"{exc} (no --resolution W H was given, so the image is the default {default}: "
+                             "give a smaller one that holds the pixels read, row-major)") from None
+        raise
 
 
 def cmd_plot(args) -> int:
     from ..plots import projections
 
     args.spp = resolve_spp(args, args.sampler)
-    projections(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, pixel=args.pixel, out=args.out,
-                size=figure_width(args), **_options(args))
+    with _default_image_named(args):
+        projections(args.sampler, spp=args.spp, dims=args.dims, seed=args.seed, pixel=args.pixel, out=args.out,
+                    size=figure_width(args), **_options(args))
     if not args.quiet:
         print(f"{args.sampler}, {args.spp} spp, {args.dims} dims -> {args.out}")
     return 0
 
 
 def cmd_spectrum(args) -> int:
+    if args.error:
+        return _error_spectrum(args)
     from ..plots import spectrum
 
+    _refuse_given(args, "of --error (the screen-space error spectrum); add --error", "integrand", "seeds")
+    if args.size_old is not None:  # one value: the old spelling of --figure-width; W H is --error's image
+        if len(args.size_old) != 1:
+            raise ValueError(f"--size {' '.join(map(str, args.size_old))}: --size W H is the image of --error "
+                             "(the screen-space error spectrum); the figure's width is --figure-width PX")
+        args.size_old = args.size_old[0]
     if args.dims is not None and args.pair is not None:
         raise ValueError("give the pair of dimensions once, as --pair I,J (--dims is its old spelling)")
+    if args.dims is not None and args.dims.strip().lstrip("+-").isdigit():  # a count: --error's
+        raise ValueError(f"--dims {args.dims} counts dimensions (the integrand's, with --error); the projection's "
+                         "pair is --pair I,J, two dimensions I,J such as 0,1")
     pair = args.pair or args.dims or "0,1"
     option = "--pair" if args.dims is None else "--dims (the old spelling of --pair)"
     try:
@@ -175,12 +222,75 @@ def cmd_spectrum(args) -> int:
     if args.dims is not None:  # advised only once parsed, so that the advice is a valid --pair
         deprecated("spectrum", f"--dims {args.dims}", f"--pair {i},{j} (--dims is a count in every command)")
     args.spp = resolve_spp(args, args.sampler)
-    _, radii, mean = spectrum(args.sampler, spp=args.spp, dims=(i, j), trials=args.trials, seed=args.seed,
-                              freq=args.freq, out=args.out, size=figure_width(args), **_options(args))
+    trials = TRIALS if args.trials is None else args.trials
+    freq = FREQ if args.freq is None else args.freq
+    if args.resolution is not None and 0 < args.resolution[0] * args.resolution[1] < trials:
+        w, h = args.resolution  # the figure's randomizations are pixels 0 .. trials-1 of the image
+        raise ValueError(f"--resolution {w} {h} has {w * h} pixels; the spectrum averages --trials {trials} "
+                         f"randomizations, pixels 0..{trials - 1}: give an image of at least {trials} pixels")
+    with _default_image_named(args):
+        _, radii, mean = spectrum(args.sampler, spp=args.spp, dims=(i, j), trials=trials, seed=args.seed,
+                                  freq=freq, out=args.out, size=figure_width(args), **_options(args))
     if not args.quiet:
         low = mean[radii <= max(2, len(radii) // 8)].mean()
-        print(f"{args.sampler}, {args.spp} spp, dims {i},{j}, {args.trials} trials: "
+        print(f"{args.sampler}, {args.spp} spp, dims {i},{j}, {trials} trials: "
               f"mean low-frequency power {low:.3f} (white noise: 1) -> {args.out}")
+    return 0
+
+
+def _refuse_given(args, what: str, *names: str) -> None:
+    """Refuse the first of the options ``names`` that was given: it is an option ``what`` says."""
+    for name in names:
+        if getattr(args, name) is not None:
+            raise ValueError(f"--{name.replace('_', '-')} is an option {what}")
+
+
+def _error_spectrum(args) -> int:
+    """``pyoa spectrum SAMPLER --error``: :func:`pyoa.analysis.error_spectrum` of the sampler on a
+    ``--size N N`` image, its figure (:func:`pyoa.plots.error_spectra`) and its table. Every option is
+    checked, and named as typed, before the first sample; one not given takes the function's default."""
+    from ..plots import error_spectra
+
+    _refuse_given(args, "of the projection's spectrum, not of --error (whose image is --size N N)",
+                  "pair", "trials", "freq", "offset", "jitter", "strength", "resolution")
+    if args.device is not None:
+        raise ValueError("--device is not taken with --error: the error spectrum runs on --backend's default "
+                         "device ($PYOA_OPENCL_DEVICE chooses it)")
+    given = {}
+    if args.dims is not None:
+        try:
+            given["dims"] = int(args.dims)
+        except ValueError:
+            raise ValueError(f"--dims {args.dims}: with --error, --dims counts the integrand's dimensions (such "
+                             "as 4); a pair I,J is the projection's (--pair, without --error)") from None
+        check_int("--dims", given["dims"], *ERROR_LIMITS["dims"])
+    if args.size_old is not None:  # the error image's W H (one value is the old spelling of --figure-width)
+        if len(args.size_old) != 2:
+            n = args.size_old[0]
+            raise ValueError(f"--size {' '.join(map(str, args.size_old))}: with --error, --size is the error "
+                             f"image's W H (square, such as --size {n} {n}); the figure's width is --figure-width PX")
+        width, height = (check_int(f"--size {name}", v, *ERROR_LIMITS["size"])
+                         for name, v in zip("WH", args.size_old))
+        if width != height:
+            side = max(width, height)
+            raise ValueError(f"--size {width} {height}: the error image is square (its spectrum's rings are "
+                             f"frequencies |k|); give --size N N, such as --size {side} {side}")
+        given["size"], args.size_old = width, None
+    if args.seeds is not None:
+        given["seeds"] = check_int("--seeds", args.seeds, *ERROR_LIMITS["seeds"])
+    seeds = given.get("seeds", ERROR_DEFAULTS["seeds"])
+    check_int("--seed", args.seed, 0, MAX_UINT32 - seeds + 1, " (the first of --seeds uint32 seeds)")
+    if args.integrand is not None:
+        given["integrand"] = args.integrand  # an unknown name is refused with the valid ones, before sampling
+    size = figure_width(args)
+    check_out(args.out, (".png",))
+    args.dims = given.get("dims")  # resolve_spp: the nearest valid count for this many dimensions
+    args.spp = resolve_spp(args, args.sampler)
+    res = error_spectrum(args.sampler, spp=args.spp, seed=args.seed, base=args.base, backend=args.backend, **given)
+    error_spectra([res], out=args.out, size=size)
+    if not args.quiet:
+        print(res.table())
+        print(f"-> {args.out}")
     return 0
 
 
@@ -223,10 +333,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
     p.add_argument("--base", type=int, default=None,
                    help="faure's prime digit base (default: the largest prime b with b^2 <= spp, or the smallest "
-                        "prime >= dims if smaller)")
-    p.add_argument("--resolution", type=int, nargs=2, metavar=("W", "H"), default=None,
-                   help="image size of a sampler that needs one (zsobol; pixels row-major, y*W + x); "
-                        "default 65536 65536")
+                        "prime >= dims if smaller); zfaure's is fixed by its count, spp = b^m")
+    p.add_argument("--resolution", type=int, nargs=2, metavar=("W", "H"), default=None, help=RESOLUTION_HELP)
     add_sampling_options(p)
     p.add_argument("--out", default="points.npy", help="output file, .npy or .csv (default points.npy)")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing")
@@ -251,18 +359,24 @@ def add_parsers(sub) -> None:
     p.add_argument("-v", "--verbose", action="store_true", help="print the whole build log of each device that fails")
     p.set_defaults(func=cmd_backends)
 
-    def figure_options(p, out):
+    def figure_options(p, out, size_help=argparse.SUPPRESS):
         p.add_argument("sampler", help="sampler name (see `pyoa samplers`)")
         p.add_argument("--spp", type=int, default=None, help=spp_help)
         p.add_argument("--seed", type=int, default=0, help="user seed (default 0)")
         p.add_argument("--offset", choices=OFFSETS, default=None, help="offset style of OA samplers")
         p.add_argument("--jitter", type=float, default=None, help="jitter amount in [0, 1]")
         p.add_argument("--strength", type=int, default=None, help="strength t (bush, cmjnd)")
-        p.add_argument("--base", type=int, default=None, help="faure's prime digit base")
+        p.add_argument("--base", type=int, default=None,
+                       help="faure's prime digit base; zfaure's is fixed by its count, spp = b^m")
+        p.add_argument("--resolution", type=int, nargs=2, metavar=("W", "H"), default=None, help=RESOLUTION_HELP)
         add_sampling_options(p)
         p.add_argument("--figure-width", type=int, default=None, metavar="PX",
                        help=f"figure width in pixels (default {FIGURE_WIDTH})")
-        p.add_argument("--size", type=int, dest="size_old", default=None, help=argparse.SUPPRESS)  # the old spelling
+        if size_help is argparse.SUPPRESS:  # --size PX: only the old spelling of --figure-width
+            p.add_argument("--size", type=int, dest="size_old", default=None, help=size_help)
+        else:  # --size W H of an image; one value is still the old --figure-width
+            p.add_argument("--size", type=int, nargs="+", dest="size_old", default=None, metavar="N",
+                           help=size_help)
         p.add_argument("--out", default=out, help=f"PNG output (default {out})")
         p.add_argument("-q", "--quiet", action="store_true", help="print nothing")
 
@@ -272,11 +386,27 @@ def add_parsers(sub) -> None:
     p.add_argument("--pixel", type=int, default=0, help="pixel index (default 0)")
     p.set_defaults(func=cmd_plot)
 
-    p = sub.add_parser("spectrum", help="expected power spectrum of a 2D projection (PNG)")
-    figure_options(p, "spectrum.png")
+    p = sub.add_parser("spectrum", help="expected power spectrum of a 2D projection, or with --error the "
+                                        "screen-space error spectrum (PNG)")
+    figure_options(p, "spectrum.png", size_help=(
+        "with --error: the error image, N N (square, {1} to {2}; default {0} {0})".format(ERROR_DEFAULTS["size"],
+                                                                                         *ERROR_LIMITS["size"])))
     p.add_argument("--pair", default=None, help="the two dimensions I,J of the projection (default 0,1)")
-    p.add_argument("--dims", default=None, help=argparse.SUPPRESS)  # the old spelling of --pair
-    p.add_argument("--trials", type=int, default=64, help="randomizations averaged (default 64)")
-    p.add_argument("--freq", type=int, default=48, help="largest integer frequency shown (default 48)")
+    p.add_argument("--trials", type=int, default=None, help=f"randomizations averaged (default {TRIALS})")
+    p.add_argument("--freq", type=int, default=None, help=f"largest integer frequency shown (default {FREQ})")
+    p.add_argument("--error", action="store_true", help=(
+        "the screen-space error spectrum instead (pyoa.analysis.error_spectrum): each pixel of a --size N N image "
+        "integrates --integrand over --dims dimensions with its own samples, and the figure shows the "
+        "periodogram of the error image over --seeds seeds (white noise: 1; a dark centre is blue noise) "
+        "and its radial mean; the table gives the low-frequency power and the per-pixel RMSE"))
+    p.add_argument("--integrand", default=None, help=(
+        f"with --error: the integrand, one of {', '.join(INTEGRANDS)} (default {ERROR_DEFAULTS['integrand']})"))
+    p.add_argument("--dims", default=None, metavar="D", help=(
+        "with --error: the integrand's dimensions, {} to {} (default {}); ".format(*ERROR_LIMITS["dims"],
+                                                                                  ERROR_DEFAULTS["dims"]) +
+        "I,J is the old spelling of --pair"))
+    p.add_argument("--seeds", type=int, default=None, metavar="N", help=(
+        f"with --error: independent images averaged, seeds --seed, --seed + 1, ... (default "
+        f"{ERROR_DEFAULTS['seeds']})"))
     p.set_defaults(func=cmd_spectrum)
 
