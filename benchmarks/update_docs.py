@@ -106,6 +106,12 @@ def _glass_mitsuba() -> str:
     return glass_mitsuba.table(figures.load(figures.RESULTS / "cornell-glass-mitsuba.json"))
 
 
+def _zfaure_evidence() -> str:
+    import zfaure_evidence
+
+    return zfaure_evidence.section_text(figures.load(zfaure_evidence.RESULTS_JSON))
+
+
 def _cluster_speedup() -> str:
     import bench_cluster
 
@@ -139,6 +145,9 @@ SECTIONS: dict[str, Entry] = {
     # benchmarks/glass_mitsuba.py: the glass Cornell box against Mitsuba 3
     "glass-mitsuba": Entry((REPO / "docs" / "rendering.md",), (figures.RESULTS / "cornell-glass-mitsuba.json",),
                            _glass_mitsuba),
+    # benchmarks/zfaure_evidence.py: zfaure's error spectra and renders against zsobol, faure, bose, pmj02
+    "zfaure-evidence": Entry((RESULTS_PAGE,), (REPO / "benchmarks" / "results" / "zfaure-evidence.json",),
+                             _zfaure_evidence),
     # benchmarks/bench_cluster.py: a study's speed-up on a local cluster
     "cluster-speedup": Entry((REPO / "docs" / "distributed.md",), (figures.RESULTS / "cluster.json",), _cluster_speedup),
 }
