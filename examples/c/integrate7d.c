@@ -58,7 +58,7 @@ static int make(pyoa_sampler *s, void **table, const char *name, pyoa_u32 spp, p
     pyoa_options options = pyoa_options_default(name, spp);
     options.dims = DIMS;
     options.seed = seed;
-    /* the image, for the one sampler that takes it (zsobol; the others refuse one, as in Python) */
+    /* the image, for the samplers that take it (zsobol, zfaure; the others refuse one, as in Python) */
     if (pyoa_lookup(name, &sampler_code) == PYOA_OK && pyoa_needs_resolution(sampler_code)) {
         options.width = WIDTH;
         options.height = HEIGHT;
