@@ -340,10 +340,6 @@ class ZSobol(Baseline):
                                       "its Z-order curve spans the image")
         return dataclasses.replace(params, resolution=resolution)
 
-    def pixel_count(self, params):
-        width, height = params.resolution
-        return width * height
-
     def arguments(self, params):
         return {"resolution": params.resolution}
 

@@ -399,7 +399,11 @@ class Construction:
         return params
 
     def pixel_count(self, params) -> int:
-        """How many pixel indices are valid: ``2**32`` unless the sampler has an image."""
+        """How many pixel indices are valid: ``width * height`` of the image of
+        a sampler that needs one (:attr:`needs_resolution`), else ``2**32``."""
+        if self.needs_resolution:
+            width, height = params.resolution
+            return width * height
         return MAX_UINT32 + 1
 
     def claims(self, params, offset: str | None) -> list[Claim]:

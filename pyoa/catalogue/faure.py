@@ -252,10 +252,6 @@ class ZFaure(Faure):
                          f"{', '.join(map(str, powers[:6]))}{', ...' if len(powers) > 6 else ''} (the count fixes "
                          "the base: give one of these counts, or no base)")
 
-    def pixel_count(self, params):
-        width, height = params.resolution
-        return width * height
-
     def arguments(self, params):
         return {"base": params.b, "resolution": params.resolution}
 
